@@ -1,0 +1,105 @@
+"""The ``ribbonwave`` command line.
+
+``ribbonwave [FILE] [--screenshot OUT.png]`` opens the editor window; it is the ``open``
+command, used whenever the first argument is not the name of a command. Every command
+is a :class:`Command` in :data:`COMMANDS`: a function that declares its arguments, a
+handler, and one line of help. ``ribbonwave --help`` lists them all.
+"""
+
+import argparse
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import NamedTuple
+
+from app import DEFAULT_STRUCTURE
+
+PROG = "ribbonwave"
+DEFAULT_COMMAND = "open"
+
+
+class CommandError(Exception):
+    """A failure the user can act on: reported as one line on stderr, exit status 2."""
+
+
+class Command(NamedTuple):
+    """A subcommand of ``ribbonwave``."""
+
+    help: str
+    add_arguments: Callable[[argparse.ArgumentParser], None]
+    run: Callable[[argparse.Namespace], int]
+
+
+def _open_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "file",
+        nargs="?",
+        type=Path,
+        default=DEFAULT_STRUCTURE,
+        metavar="FILE",
+        help="structure file (PDB or mmCIF, optionally gzipped); default: the bundled 1UBQ.pdb",
+    )
+    parser.add_argument(
+        "--screenshot",
+        type=Path,
+        metavar="OUT.png",
+        help="render the window to a PNG image and exit instead of running interactively",
+    )
+
+
+def _open(args: argparse.Namespace) -> int:
+    # Qt and VTK load only for the window, so commands without one start fast.
+    from PySide6.QtWidgets import QApplication
+
+    from app.main_window import MainWindow, read_ca_chains
+
+    try:
+        chains = read_ca_chains(args.file)
+    except (OSError, ValueError) as error:
+        raise CommandError(str(error)) from error
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    window = MainWindow(args.file, chains)
+    window.show()
+    if args.screenshot is None:
+        return app.exec()
+    try:
+        window.save_screenshot(args.screenshot)
+    except OSError as error:
+        raise CommandError(str(error)) from error
+    finally:
+        window.close()
+    return 0
+
+
+COMMANDS: dict[str, Command] = {
+    DEFAULT_COMMAND: Command("open a structure in the editor window (the default)", _open_arguments, _open),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the parser of all commands; ``main`` supplies the default command."""
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        usage=f"{PROG} [FILE] [--screenshot OUT.png]\n       {PROG} COMMAND [ARGS ...]",
+        description="Multiresolution (wavelet) analysis and editing of protein structures. "
+        f"Without a command, FILE opens in the editor window (the {DEFAULT_COMMAND!r} command).",
+    )
+    subparsers = parser.add_subparsers(title="commands", dest="command", metavar="COMMAND", required=True)
+    for name, command in COMMANDS.items():
+        subparser = subparsers.add_parser(name, help=command.help, description=command.help)
+        command.add_arguments(subparser)
+        subparser.set_defaults(run=command.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``ribbonwave`` with ``argv`` (default: ``sys.argv[1:]``) and return the exit status."""
+    args_list = list(sys.argv[1:] if argv is None else argv)
+    if not args_list or (args_list[0] not in COMMANDS and args_list[0] not in ("-h", "--help")):
+        args_list.insert(0, DEFAULT_COMMAND)
+    args = build_parser().parse_args(args_list)
+    try:
+        return args.run(args)
+    except CommandError as error:
+        print(f"{PROG}: error: {error}", file=sys.stderr)
+        return 2
