@@ -7,6 +7,7 @@ handler, and one line of help. ``ribbonwave --help`` lists them all.
 """
 
 import argparse
+import signal
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -61,6 +62,7 @@ def _open(args: argparse.Namespace) -> int:
     window = MainWindow(args.file, chains)
     window.show()
     if args.screenshot is None:
+        signal.signal(signal.SIGINT, signal.SIG_DFL)  # let Ctrl+C in the terminal end the event loop
         return app.exec()
     try:
         window.save_screenshot(args.screenshot)
@@ -86,7 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     subparsers = parser.add_subparsers(title="commands", dest="command", metavar="COMMAND", required=True)
     for name, command in COMMANDS.items():
-        subparser = subparsers.add_parser(name, help=command.help, description=command.help)
+        subparser = subparsers.add_parser(name, prog=f"{PROG} {name}", help=command.help, description=command.help)
         command.add_arguments(subparser)
         subparser.set_defaults(run=command.run)
     return parser

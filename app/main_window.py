@@ -12,7 +12,7 @@ import numpy as np
 import pyvista as pv
 from pyvistaqt import QtInteractor
 from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
-from PySide6.QtWidgets import QApplication, QMainWindow, QWidget
+from PySide6.QtWidgets import QMainWindow, QWidget
 
 CA_TRACE_ACTOR = "ca_trace"
 """Name of the actor that draws the Cα trace."""
@@ -36,7 +36,7 @@ def read_ca_chains(path: Path) -> list[np.ndarray]:
     OSError
         The file cannot be opened.
     ValueError
-        The file is not a readable structure or holds no chain with two Cα atoms.
+        The file is not a readable structure or holds no chain with at least two Cα atoms.
     """
     try:
         structure = gemmi.read_structure(str(path))
@@ -48,7 +48,8 @@ def read_ca_chains(path: Path) -> list[np.ndarray]:
     chains = []
     if len(structure) > 0:
         for chain in structure[0]:
-            positions = [atom.pos.tolist() for residue in chain.get_polymer() if (atom := residue.find_atom("CA", "*"))]
+            atoms = (residue.find_atom("CA", "*") for residue in chain.get_polymer())
+            positions = [atom.pos.tolist() for atom in atoms if atom]
             if len(positions) >= 2:
                 chains.append(np.array(positions, dtype=float))
     if not chains:
@@ -92,7 +93,6 @@ class MainWindow(QMainWindow):
             The image cannot be written.
         """
         self.plotter.render()
-        QApplication.processEvents()
         if not self.grab().save(str(path), "PNG"):
             raise OSError(f"cannot write {path}")
 

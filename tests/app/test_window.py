@@ -1,6 +1,6 @@
 """The editor window on the bundled example, and the ``ribbonwave`` command that opens it."""
 
-from collections.abc import Iterator
+import re
 from pathlib import Path
 
 import numpy as np
@@ -10,10 +10,11 @@ from PySide6.QtWidgets import QApplication
 from pytestqt.qtbot import QtBot
 
 from app import DEFAULT_STRUCTURE
-from app.cli import main
+from app.cli import COMMANDS, main
 from app.main_window import CA_TRACE_ACTOR, MainWindow, read_ca_chains
 
 UBIQUITIN_RESIDUES = 76
+DATA = Path(__file__).resolve().parent.parent / "data"
 
 
 def _pixels(image: QImage) -> np.ndarray:
@@ -30,18 +31,22 @@ def _count_blue(pixels: np.ndarray) -> int:
 
 
 @pytest.fixture
-def window(qtbot: QtBot) -> Iterator[MainWindow]:
+def window(qtbot: QtBot) -> MainWindow:
     window = MainWindow(DEFAULT_STRUCTURE, read_ca_chains(DEFAULT_STRUCTURE))
-    qtbot.addWidget(window)
+    qtbot.addWidget(window)  # closed, and so its plotter too, after the test
     window.show()
     qtbot.waitExposed(window)
-    yield window
-    window.close()
+    return window
 
 
 def test_bundled_example_is_ubiquitin() -> None:
     (chain,) = read_ca_chains(DEFAULT_STRUCTURE)
     assert chain.shape == (UBIQUITIN_RESIDUES, 3)
+
+
+def test_one_trace_per_protein_chain() -> None:
+    chains = read_ca_chains(DATA / "4HHB.pdb.gz")  # haemoglobin: two alpha and two beta chains
+    assert [chain.shape for chain in chains] == [(141, 3), (146, 3), (141, 3), (146, 3)]
 
 
 def test_window_renders_the_ca_trace(window: MainWindow) -> None:
@@ -85,8 +90,18 @@ def test_unreadable_file_is_a_one_line_error(
     assert err.count("\n") == 1
 
 
+def test_unwritable_screenshot_is_a_one_line_error(
+    qapp: QApplication, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    shot = tmp_path / "no-such-folder" / "shot.png"
+    assert main(["--screenshot", str(shot)]) == 2
+    assert capsys.readouterr().err == f"ribbonwave: error: cannot write {shot}\n"
+
+
 def test_help_lists_the_commands(capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as exit_info:
         main(["--help"])
     assert exit_info.value.code == 0
-    assert "open" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    for name in COMMANDS:
+        assert re.search(rf"^ +{name} ", out, re.MULTILINE)
