@@ -8,8 +8,8 @@ parameter (mathematics document, section 10.4). After an edit every atom ``x`` o
 
 Frenet normals are undefined on straight pieces and flip sign at inflections, so frames
 are made continuous: along the chain each binormal keeps the sign of its predecessor,
-degenerate frames take the normal of the nearest well-defined residue, and frames of an
-edited curve are oriented like the frames of the same residues before the edit.
+residues where the curve hardly turns take the normal of the nearest residue where it
+does, and frames of an edited curve are oriented like those of the same residues before.
 """
 
 from __future__ import annotations
@@ -18,8 +18,10 @@ import numpy as np
 
 from .splines import SplineSpace
 
-DEGENERATE = 1e-6
-"""Frames with ``|f' x f''| < DEGENERATE |f'|^2`` have no usable Frenet normal."""
+MIN_TURN = 0.05
+"""Frenet normals are used where the tangent turns by more than this (radians) per curve
+segment (``|f' x f''| / |f'|^2 / 2**J``): about 1 in helices, 0.1-0.6 in strands and
+loops, 0 on straight pieces and at inflections, where the normal is unstable."""
 
 
 def residue_frames(
@@ -27,12 +29,17 @@ def residue_frames(
 ) -> np.ndarray:
     """Rotation matrices ``[T N B]`` (columns) of the curve at the parameters ``u``.
 
+    Where the curve turns too little (:data:`MIN_TURN`) the normal is that of the nearest
+    residue with a usable Frenet frame, made perpendicular to the tangent; so a rigid
+    motion of the curve moves every frame by the same motion.
+
     Parameters
     ----------
     space, points : the curve (finest control points).
     u : (N,) residue parameters, in chain order.
-    reference : (N, 3, 3) frames of the same residues before an edit; the new frames take
-        their orientation (sign of the binormal, normal where degenerate) from these.
+    reference : (N, 3, 3) frames of the same residues before an edit; the new binormals
+        take their signs from these (instead of from the previous residue), and if no
+        residue has a usable Frenet frame the reference normals are used.
 
     Returns
     -------
@@ -43,18 +50,19 @@ def residue_frames(
     tangent = d1 / np.linalg.norm(d1, axis=1, keepdims=True)
     binormal = np.cross(d1, d2)
     strength = np.linalg.norm(binormal, axis=1)
-    defined = strength > DEGENERATE * np.einsum("ij,ij->i", d1, d1)
+    defined = strength > MIN_TURN * space.n_segments * np.einsum("ij,ij->i", d1, d1)
     binormal[defined] /= strength[defined, None]
     binormal[~defined] = 0.0
     if reference is None:
         binormal = _continuous_along_chain(binormal, defined)
-        fallback_normal = np.cross(binormal, tangent)[_nearest_defined(defined)]
     else:
         binormal *= np.where(np.einsum("ij,ij->i", binormal, reference[:, :, 2]) < 0, -1.0, 1.0)[:, None]
-        fallback_normal = reference[:, :, 1]
     normal = np.cross(binormal, tangent)
     if not defined.all():
-        normal[~defined] = _perpendicular(fallback_normal[~defined], tangent[~defined])
+        hint = normal[_nearest_defined(defined)] if defined.any() else (
+            reference[:, :, 1] if reference is not None else np.zeros_like(normal)
+        )
+        normal[~defined] = _perpendicular(hint[~defined], tangent[~defined])
     normal /= np.linalg.norm(normal, axis=1, keepdims=True)
     return np.stack([tangent, normal, np.cross(tangent, normal)], axis=2)
 
