@@ -7,20 +7,21 @@ handler, and one line of help. ``ribbonwave --help`` lists them all.
 """
 
 import argparse
+import os
 import signal
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
-from app import DEFAULT_STRUCTURE
+from app import DEFAULT_STRUCTURE, structure_commands
 
 PROG = "ribbonwave"
 DEFAULT_COMMAND = "open"
 
 
 class CommandError(Exception):
-    """A failure the user can act on: reported as one line on stderr, exit status 2."""
+    """A failure the user can act on: reported as one line on stderr, exit status 1."""
 
 
 class Command(NamedTuple):
@@ -75,6 +76,12 @@ def _open(args: argparse.Namespace) -> int:
 
 COMMANDS: dict[str, Command] = {
     DEFAULT_COMMAND: Command("open a structure in the editor window (the default)", _open_arguments, _open),
+    "info": Command("chains, segments, residues, secondary structure and levels of a structure",
+                    structure_commands.info_arguments, structure_commands.run_info),
+    "curve": Command("the residue points C^r of the ribbon at a level, one row per residue",
+                     structure_commands.curve_arguments, structure_commands.run_curve),
+    "edit": Command("move one control point (or residue curve point) at a level and save the model",
+                    structure_commands.edit_arguments, structure_commands.run_edit),
 }
 
 
@@ -102,6 +109,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(args_list)
     try:
         return args.run(args)
-    except CommandError as error:
+    except (CommandError, structure_commands.InputError) as error:
         print(f"{PROG}: error: {error}", file=sys.stderr)
-        return 2
+        return 1
+    except BrokenPipeError:  # output piped into a reader that stopped early (e.g. head)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1

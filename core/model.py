@@ -15,7 +15,7 @@ import numpy as np
 
 from .editing import changed_segments, move_control_point, tug_curve
 from .frames import remap_atoms, residue_frames
-from .ribbon import Ribbon, RibbonKind, build_ribbon
+from .ribbon import Ribbon, RibbonKind, segment_ribbon
 from .structure import BackboneSegment, Structure, write_structure
 
 
@@ -69,7 +69,7 @@ class EditableModel:
         self.structure = structure
         self.kind = RibbonKind(kind)
         self.coords = np.array(structure.coords)
-        self.ribbons = [_segment_ribbon(s, self.kind, helix_offset) for s in structure.segments]
+        self.ribbons = [segment_ribbon(s, self.kind, helix_offset) for s in structure.segments]
 
     @property
     def segments(self) -> tuple[BackboneSegment, ...]:
@@ -127,18 +127,6 @@ class EditableModel:
         if not 0 <= segment < len(self.ribbons):
             raise ValueError(f"segment must be in [0, {len(self.ribbons) - 1}]; got {segment}")
         return self.ribbons[segment]
-
-
-def _segment_ribbon(segment: BackboneSegment, kind: RibbonKind, helix_offset: float) -> Ribbon:
-    return build_ribbon(
-        kind,
-        segment.ca,
-        n_start=segment.n[0],
-        c_end=segment.c[-1],
-        o=segment.o,
-        helix=segment.ss == "H",
-        helix_offset=helix_offset,
-    )
 
 
 def _residue_rows(segment: BackboneSegment, residues: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -27,6 +27,7 @@ from scipy import linalg
 
 from . import _validate
 from .splines import SplineSpace, spline_space
+from .structure import BackboneSegment
 from .wavelets import fractional_points
 
 
@@ -166,6 +167,19 @@ def build_ribbon(
         residue_u = (front + np.arange(1, n_residues + 1)) / 2**level
         _interpolate(points, residue_u, ca, first=front + 2, level=level)
     return Ribbon(kind, points, residue_u, n_curve, front)
+
+
+def segment_ribbon(segment: BackboneSegment, kind: RibbonKind | str, helix_offset: float = 0.0) -> Ribbon:
+    """The ribbon of a backbone segment read from a file (N and C atoms as terminal points)."""
+    return build_ribbon(
+        kind,
+        segment.ca,
+        n_start=segment.n[0],
+        c_end=segment.c[-1],
+        o=segment.o,
+        helix=segment.ss == "H",
+        helix_offset=helix_offset,
+    )
 
 
 def _terminal(atom: np.ndarray | None, fallback: np.ndarray) -> np.ndarray:

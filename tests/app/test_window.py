@@ -82,7 +82,7 @@ def test_unreadable_file_is_a_one_line_error(
     path = tmp_path / "input.pdb"
     if content is not None:
         path.write_text(content)
-    assert main([str(path)]) == 2
+    assert main([str(path)]) == 1
     out, err = capsys.readouterr()
     assert out == ""
     assert err.startswith("ribbonwave: error: ")
@@ -94,7 +94,7 @@ def test_unwritable_screenshot_is_a_one_line_error(
     qapp: QApplication, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     shot = tmp_path / "no-such-folder" / "shot.png"
-    assert main(["--screenshot", str(shot)]) == 2
+    assert main(["--screenshot", str(shot)]) == 1
     assert capsys.readouterr().err == f"ribbonwave: error: cannot write {shot}\n"
 
 
