@@ -177,7 +177,9 @@ def run_edit(args: argparse.Namespace) -> int:
             edit = model.tug(number, args.level, float(ribbon.residue_u[residue]), args.move)
         model.apply(edit)
         written = model.save(args.output, overwrite=args.overwrite)
-    except (ValueError, FileExistsError, OSError) as error:
+    except FileExistsError as error:
+        raise InputError(f"{error} (pass --overwrite to replace it)") from None
+    except (ValueError, OSError) as error:
         raise InputError(str(error)) from None
     labels = structure.segments[number].labels
     moved = f"{labels[edit.residues[0]]}-{labels[edit.residues[-1]]}" if len(edit.residues) else "none"
