@@ -7,25 +7,15 @@ any level to the finest in under 1 ms for 2,000 residues (2**11 segments).
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
+
+from timing import best_ms
 
 from core.editing import move_control_point, tug_curve
 from core.filters import level_filters, refinement_matrix, wavelet_matrix
 from core.wavelets import decompose, reconstruct
 
 DENSE_UP_TO = 12  # dense analysis matrices beyond 2**12 + 3 rows take minutes and gigabytes
-
-
-def best_time(function, repeats: int = 20) -> float:
-    """Best wall-clock time of ``function()`` in milliseconds."""
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return 1e3 * min(times)
 
 
 def dense_analysis(level: int) -> list[np.ndarray]:
@@ -55,20 +45,20 @@ def main() -> None:
         for j in range(1, level + 1):
             level_filters(j)  # build the cached filters outside the timing
         transform = decompose(points)
-        t_dec = best_time(lambda: decompose(points))
-        t_rec = best_time(lambda: reconstruct(transform))
+        t_dec = best_ms(lambda: decompose(points))
+        t_rec = best_ms(lambda: reconstruct(transform))
         dense = "-"
         if level <= DENSE_UP_TO:
             inverses = dense_analysis(level)
-            dense = f"{best_time(lambda: dense_decompose(points, inverses), repeats=3):.2f}"
+            dense = f"{best_ms(lambda: dense_decompose(points, inverses), repeats=3):.2f}"
         print(f"{level:>5} {len(points):>7} {t_dec:>10.3f} {t_rec:>12.3f} {1e3 * t_dec / len(points):>15.3f} {dense:>16}")
 
     finest = 11  # 2,000 residues pad to 2**11 segments
     print(f"\nOne edit pushed to the finest level {finest} (2,051 control points), best of 200 runs, ms")
     print(f"{'level':>6} {'move point':>11} {'tug curve':>10}")
     for level in (0, 2, 4, 6, 8, 9.5, 10, 10.75, 11):
-        t_move = best_time(lambda: move_control_point(level, 2, np.array([1.0, 0.0, 0.0]), finest), 200)
-        t_tug = best_time(lambda: tug_curve(level, 0.37, np.array([1.0, 0.0, 0.0]), finest), 200)
+        t_move = best_ms(lambda: move_control_point(level, 2, np.array([1.0, 0.0, 0.0]), finest), 200)
+        t_tug = best_ms(lambda: tug_curve(level, 0.37, np.array([1.0, 0.0, 0.0]), finest), 200)
         print(f"{level:>6} {t_move:>11.3f} {t_tug:>10.3f}")
 
 

@@ -9,10 +9,11 @@ to end). Targets: under 5 ms for a 5,000-atom protein, under 50 ms for 100,000 a
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
+
+from timing import best_ms
 
 from core.editing import move_control_point
 from core.frames import remap_atoms, residue_frames
@@ -21,15 +22,6 @@ from core.ribbon import build_ribbon
 from core.structure import read_structure
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
-
-
-def best_ms(function, repeats: int = 10) -> float:
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return 1e3 * min(times)
 
 
 def longest_segment_edit(model: EditableModel) -> tuple[int, int, float]:
