@@ -3,7 +3,9 @@
 The only module of core/ that touches gemmi. :func:`read_structure` returns a frozen
 :class:`Structure`: the coordinates of every atom of the first model plus the protein
 backbone cut into continuous :class:`BackboneSegment` s; :func:`write_structure` writes
-new coordinates for the same atoms. The gemmi objects stay private inside ``Structure``.
+new coordinates for the same atoms; :func:`read_atoms` returns just the :class:`AtomTable`
+of any entry (DNA without protein included), for surfaces and maps. The gemmi objects stay
+private inside ``Structure``.
 
 Conventions
 -----------
@@ -137,6 +139,49 @@ class ChainSummary:
     n_segments: int
 
 
+ATOM_CATEGORIES = ("protein", "nucleic", "ligand", "water")
+"""Values of ``AtomTable.category``: polymer amino acids, polymer nucleotides, every other
+non-water group (ligands, ions, non-polymer hetero groups), and waters."""
+
+
+@dataclass(frozen=True, eq=False)
+class AtomTable:
+    """Every atom of the first model, in the order of ``Structure.coords``; read-only arrays.
+
+    Attributes
+    ----------
+    entry_id : str
+    coords : (n_atoms, 3) float64, Å
+    name, element, altloc : (n_atoms,) str
+        Atom name, element symbol ('C', 'Fe', ...) and alternate location ('' where none).
+    resname, chain : (n_atoms,) str
+    resseq : (n_atoms,) int64
+        Author residue numbers.
+    residue : (n_atoms,) int64
+        Ordinal of the atom's residue in the model (file order, from 0).
+    b_factor : (n_atoms,) float64, Å²
+    occupancy : (n_atoms,) float64
+    category : (n_atoms,) str
+        One of :data:`ATOM_CATEGORIES`.
+    """
+
+    entry_id: str
+    coords: NDArray[np.float64]
+    name: NDArray[np.str_]
+    element: NDArray[np.str_]
+    altloc: NDArray[np.str_]
+    resname: NDArray[np.str_]
+    chain: NDArray[np.str_]
+    resseq: NDArray[np.int64]
+    residue: NDArray[np.int64]
+    b_factor: NDArray[np.float64]
+    occupancy: NDArray[np.float64]
+    category: NDArray[np.str_]
+
+    def __len__(self) -> int:
+        return len(self.coords)
+
+
 @dataclass(frozen=True, eq=False)
 class Structure:
     """The first model of a PDB/mmCIF entry as arrays; see the module docstring.
@@ -164,6 +209,8 @@ class Structure:
         First-model atoms of non-water HETATM groups, of waters, and with an altloc.
     warnings : tuple of str
         What was skipped or ignored while reading.
+    atoms : AtomTable
+        Names, elements, residues, B-factors and occupancies of the atoms of ``coords``.
     """
 
     path: Path
@@ -180,6 +227,7 @@ class Structure:
     n_water_atoms: int
     n_altloc_atoms: int
     warnings: tuple[str, ...]
+    atoms: AtomTable
     _template: gemmi.Structure = field(repr=False)
     _text: str = field(repr=False)
 
@@ -215,15 +263,7 @@ def read_structure(path: str | os.PathLike[str]) -> Structure:
         coordinates; the message names the file.
     """
     path = Path(path)
-    text = _read_text(path)
-    fmt = "mmcif" if _looks_like_mmcif(text) else "pdb"
-    st = _parse(text, fmt, path)
-    atoms = _scan_model(st[0])
-    if len(atoms.coords) == 0:
-        raise StructureError(f"{path}: not a structure file (no atoms found)")
-    if not np.isfinite(atoms.coords).all():
-        bad = int((~np.isfinite(atoms.coords).all(axis=1)).sum())
-        raise StructureError(f"{path}: {bad} atom(s) have non-finite coordinates")
+    text, fmt, st, atoms = _read_model(path)
     notes: list[str] = []
     groups = _residue_groups(atoms)
     runs = _backbone_runs(atoms, groups, notes)
@@ -249,8 +289,63 @@ def read_structure(path: str | os.PathLike[str]) -> Structure:
         n_water_atoms=atoms.n_water,
         n_altloc_atoms=atoms.n_altloc,
         warnings=tuple(notes),
+        atoms=_atom_table(st.name, atoms),
         _template=st,
         _text=text,
+    )
+
+
+def read_atoms(path: str | os.PathLike[str]) -> AtomTable:
+    """Read every atom of the first model of a PDB or mmCIF file (optionally gzipped).
+
+    Unlike :func:`read_structure` this needs no protein chain (e.g. a DNA duplex).
+
+    Raises
+    ------
+    StructureError
+        Missing, empty or unreadable file, no atoms, or non-finite coordinates.
+    """
+    path = Path(path)
+    _, _, st, atoms = _read_model(path)
+    return _atom_table(st.name, atoms)
+
+
+def _read_model(path: Path) -> tuple[str, str, gemmi.Structure, _Atoms]:
+    """Text, format, parsed structure and scanned first model of a file with finite atoms."""
+    text = _read_text(path)
+    fmt = "mmcif" if _looks_like_mmcif(text) else "pdb"
+    st = _parse(text, fmt, path)
+    atoms = _scan_model(st[0])
+    if len(atoms.coords) == 0:
+        raise StructureError(f"{path}: not a structure file (no atoms found)")
+    if not np.isfinite(atoms.coords).all():
+        bad = int((~np.isfinite(atoms.coords).all(axis=1)).sum())
+        raise StructureError(f"{path}: {bad} atom(s) have non-finite coordinates")
+    return text, fmt, st, atoms
+
+
+def _atom_table(entry_id: str, atoms: _Atoms) -> AtomTable:
+    counts = atoms.stop - atoms.start
+
+    def per_atom(values: object, dtype: type) -> np.ndarray:
+        return _frozen(np.repeat(np.asarray(values, dtype=dtype), counts))
+
+    category = np.select(
+        [atoms.water, atoms.protein, atoms.nucleic], ["water", "protein", "nucleic"], "ligand"
+    )
+    return AtomTable(
+        entry_id=entry_id,
+        coords=_frozen(atoms.coords),
+        name=_frozen(np.array(atoms.atom_name, dtype=str).reshape(-1)),
+        element=_frozen(np.array(atoms.element, dtype=str).reshape(-1)),
+        altloc=_frozen(np.array(atoms.altloc, dtype="<U1").reshape(-1)),
+        resname=per_atom(atoms.resname, str),
+        chain=per_atom(atoms.chain, str),
+        resseq=per_atom(atoms.seq, np.int64),
+        residue=per_atom(np.arange(len(counts)), np.int64),
+        b_factor=_frozen(np.array(atoms.b_factor, dtype=np.float64)),
+        occupancy=_frozen(np.array(atoms.occupancy, dtype=np.float64)),
+        category=per_atom(category, str),
     )
 
 
@@ -321,6 +416,13 @@ class _Atoms:
     start: np.ndarray
     stop: np.ndarray
     backbone: np.ndarray  # (n_res, 4) rows of coords for N, CA, C, O, -1 if missing
+    nucleic: np.ndarray  # bool, polymer nucleotide
+    water: np.ndarray  # bool
+    atom_name: list[str]  # per atom from here on
+    element: list[str]
+    altloc: list[str]
+    b_factor: list[float]
+    occupancy: list[float]
     n_hetero: int
     n_water: int
     n_altloc: int
@@ -330,8 +432,10 @@ def _scan_model(model: gemmi.Model) -> _Atoms:
     """Walk the model once (chain, residue, atom) and collect everything needed."""
     xyz: list[tuple[float, float, float]] = []
     chain, part, seq, icode, resname, protein, start, stop, backbone = ([] for _ in range(9))
+    nucleic, water, atom_name, element, altloc, b_factor, occupancy = ([] for _ in range(7))
     n_hetero = n_water = n_altloc = 0
     amino_acid: dict[str, bool] = {}
+    nucleotide: dict[str, bool] = {}
     for k, ch in enumerate(model):
         peptide_chain = ch.get_polymer().check_polymer_type() in _PEPTIDE
         for res in ch:
@@ -342,6 +446,11 @@ def _scan_model(model: gemmi.Model) -> _Atoms:
                 p = atom.pos
                 xyz.append((p.x, p.y, p.z))
                 alt = atom.altloc if atom.has_altloc() else ""
+                atom_name.append(atom.name)
+                element.append(atom.element.name)
+                altloc.append(alt)
+                b_factor.append(atom.b_iso)
+                occupancy.append(atom.occ)
                 n_altloc += alt != ""
                 conformer = conformer or alt
                 if atom.name in _BACKBONE and alt in ("", conformer):
@@ -353,8 +462,12 @@ def _scan_model(model: gemmi.Model) -> _Atoms:
             elif res.het_flag == "H":
                 n_hetero += len(res)
             if res.name not in amino_acid:
-                amino_acid[res.name] = gemmi.find_tabulated_residue(res.name).is_amino_acid()
+                tabulated = gemmi.find_tabulated_residue(res.name)
+                amino_acid[res.name] = tabulated.is_amino_acid()
+                nucleotide[res.name] = tabulated.is_nucleic_acid()
             polymer = res.entity_type == gemmi.EntityType.Polymer
+            nucleic.append(polymer and nucleotide[res.name])
+            water.append(res.is_water())
             chain.append(ch.name)
             part.append(k)
             seq.append(res.seqid.num)
@@ -375,6 +488,13 @@ def _scan_model(model: gemmi.Model) -> _Atoms:
         start=np.array(start, dtype=np.int64),
         stop=np.array(stop, dtype=np.int64),
         backbone=np.array(backbone, dtype=np.int64).reshape(-1, 4),
+        nucleic=np.array(nucleic, dtype=bool),
+        water=np.array(water, dtype=bool),
+        atom_name=atom_name,
+        element=element,
+        altloc=altloc,
+        b_factor=b_factor,
+        occupancy=occupancy,
         n_hetero=n_hetero,
         n_water=n_water,
         n_altloc=n_altloc,
