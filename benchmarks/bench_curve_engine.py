@@ -38,7 +38,7 @@ def dense_decompose(points: np.ndarray, inverses: list[np.ndarray]) -> list[np.n
 
 def main() -> None:
     rng = np.random.default_rng(0)
-    print("Filter bank, 3-D control points (best of 20 runs, ms)")
+    print("Filter bank, 3-D control points (best of 10 runs, ms)")
     print(f"{'level':>5} {'points':>7} {'decompose':>10} {'reconstruct':>12} {'per point (us)':>15} {'dense decompose':>16}")
     for level in range(6, 17):
         points = rng.normal(size=(2**level + 3, 3))
