@@ -1,6 +1,6 @@
 """The ``ribbonwave`` command line.
 
-``ribbonwave [FILE] [--screenshot OUT.png]`` opens the editor window; it is the ``open``
+``ribbonwave [FILE] [--screenshot OUT.png] [--level L]`` opens the editor window; it is the ``open``
 command, used whenever the first argument is not the name of a command. Every command
 is a :class:`Command` in :data:`COMMANDS`: a function that declares its arguments, a
 handler, and one line of help. ``ribbonwave --help`` lists them all.
@@ -47,24 +47,44 @@ def _open_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="OUT.png",
         help="render the window to a PNG image and exit instead of running interactively",
     )
+    parser.add_argument(
+        "--level",
+        type=float,
+        metavar="L",
+        help="start at this level (0 .. log2 N; default: about two levels below full resolution)",
+    )
+    parser.add_argument(
+        "--ribbon",
+        choices=("peptide", "calpha"),
+        default="peptide",
+        help="peptide-plane ribbon (default) or the curve through the Cα atoms",
+    )
 
 
 def _open(args: argparse.Namespace) -> int:
     # Qt and VTK load only for the window, so commands without one start fast.
     from PySide6.QtWidgets import QApplication
 
-    from app.main_window import MainWindow, read_ca_chains
+    from app.document import Document
+    from app.main_window import MainWindow
+    from core.structure import StructureError
 
-    try:
-        chains = read_ca_chains(args.file)
-    except (OSError, ValueError) as error:
-        raise CommandError(str(error)) from error
+    if args.level is not None and not args.level >= 0:
+        raise CommandError(f"--level must be >= 0; got {args.level:g}")
     app = QApplication.instance() or QApplication(sys.argv[:1])
-    window = MainWindow(args.file, chains)
+    document = Document()
+    try:
+        document.open(args.file, args.ribbon)
+    except StructureError as error:
+        raise CommandError(str(error)) from error
+    if args.level is not None:
+        document.set_level(args.level)
+    window = MainWindow(document)
     window.show()
     if args.screenshot is None:
         signal.signal(signal.SIGINT, signal.SIG_DFL)  # let Ctrl+C in the terminal end the event loop
         return app.exec()
+    app.processEvents()  # lay the window out before it is grabbed
     try:
         window.save_screenshot(args.screenshot)
     except OSError as error:
@@ -89,7 +109,7 @@ def build_parser() -> argparse.ArgumentParser:
     """Return the parser of all commands; ``main`` supplies the default command."""
     parser = argparse.ArgumentParser(
         prog=PROG,
-        usage=f"{PROG} [FILE] [--screenshot OUT.png]\n       {PROG} COMMAND [ARGS ...]",
+        usage=f"{PROG} [FILE] [--screenshot OUT.png] [--level L]\n       {PROG} COMMAND [ARGS ...]",
         description="Multiresolution (wavelet) analysis and editing of protein structures. "
         f"Without a command, FILE opens in the editor window (the {DEFAULT_COMMAND!r} command).",
     )

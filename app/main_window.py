@@ -1,102 +1,354 @@
-"""The editor's main window: a VTK view of the structure inside a QMainWindow.
+"""The editor's main window: the 3D view, the docks, menus, toolbar and status bar.
 
-For now the view shows the Cα trace of the structure, one polyline per chain.
-The ``app`` package sets ``QT_API`` before this module imports pyvistaqt.
+The window wires the pieces together: a :class:`~app.document.Document`, the
+:class:`~app.scene.Scene` drawing it into a pyvistaqt ``QtInteractor``, the
+:class:`~app.picking.PointerAdapter` feeding mouse events to the
+:class:`~app.drag.DragController`, and the dock panels. It also owns the file dialogs
+(open, save, recent files, drag-and-drop, image export) and asks before unsaved edits
+would be lost. The ``app`` package sets ``QT_API`` before this module imports pyvistaqt.
 """
 
-from collections.abc import Sequence
+from __future__ import annotations
+
 from pathlib import Path
 
-import gemmi
 import numpy as np
-import pyvista as pv
 from pyvistaqt import QtInteractor
-from PySide6.QtGui import QAction, QCloseEvent, QKeySequence
-from PySide6.QtWidgets import QMainWindow, QWidget
+from PySide6.QtCore import QPoint, QSettings, Qt
+from PySide6.QtGui import (
+    QAction,
+    QActionGroup,
+    QCloseEvent,
+    QDragEnterEvent,
+    QDropEvent,
+    QImage,
+    QKeySequence,
+    QPainter,
+)
+from PySide6.QtWidgets import (
+    QDockWidget,
+    QFileDialog,
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QStyle,
+    QUndoView,
+    QWidget,
+)
 
-CA_TRACE_ACTOR = "ca_trace"
-"""Name of the actor that draws the Cα trace."""
+from app import EXAMPLES_DIR
+from app.document import Document
+from app.drag import DragController, Mode, PointerEvent
+from app.panels import DisplayPanel, RibbonDimensionPanel
+from app.picking import PRIORITY, PointerAdapter
+from app.scene import Scene
+from core.structure import StructureError
 
-
-def read_ca_chains(path: Path) -> list[np.ndarray]:
-    """Read the Cα trace of each polymer chain of the first model of a structure file.
-
-    Parameters
-    ----------
-    path
-        PDB or mmCIF file, optionally gzipped.
-
-    Returns
-    -------
-    list of ndarray, shape (n_residues, 3)
-        Cα coordinates in Å, one array per chain with at least two Cα atoms, in file order.
-
-    Raises
-    ------
-    OSError
-        The file cannot be opened.
-    ValueError
-        The file is not a readable structure or holds no chain with at least two Cα atoms.
-    """
-    try:
-        structure = gemmi.read_structure(str(path))
-    except OSError as error:
-        raise OSError(f"cannot read {path}: {error.strerror}") from error
-    except (RuntimeError, ValueError) as error:
-        raise ValueError(f"cannot read {path}: {error}") from error
-    structure.setup_entities()
-    chains = []
-    if len(structure) > 0:
-        for chain in structure[0]:
-            atoms = (residue.find_atom("CA", "*") for residue in chain.get_polymer())
-            positions = [atom.pos.tolist() for atom in atoms if atom]
-            if len(positions) >= 2:
-                chains.append(np.array(positions, dtype=float))
-    if not chains:
-        raise ValueError(f"no chain with Cα atoms in {path}")
-    return chains
-
-
-def _polylines(chains: Sequence[np.ndarray]) -> pv.PolyData:
-    """One polyline cell per chain; ``chains`` as returned by :func:`read_ca_chains`."""
-    bounds = np.cumsum([0, *(len(chain) for chain in chains)])
-    lines = np.concatenate([np.r_[stop - start, start:stop] for start, stop in zip(bounds[:-1], bounds[1:])])
-    return pv.PolyData(np.concatenate(chains), lines=lines)
+APP_NAME = "ribbonwave"
+RECENT_KEY = "recentFiles"
+MAX_RECENT = 8
+STRUCTURE_FILTER = "Structures (*.pdb *.ent *.cif *.mmcif *.gz);;All files (*)"
+SAVE_FILTERS = {"PDB (*.pdb *.pdb.gz *.ent)": ".pdb", "mmCIF (*.cif *.cif.gz *.mmcif)": ".cif"}
+SAVE_SUFFIXES = (".pdb", ".ent", ".cif", ".mmcif", ".pdb.gz", ".ent.gz", ".cif.gz", ".mmcif.gz")
 
 
 class MainWindow(QMainWindow):
-    """Main window showing the Cα trace of a structure in a VTK view."""
+    """The editor window on a :class:`Document` (a new, empty one when none is given)."""
 
-    def __init__(self, path: Path, chains: Sequence[np.ndarray], parent: QWidget | None = None) -> None:
+    def __init__(self, document: Document | None = None, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.setWindowTitle(f"ribbonwave — {path.name}")
-        self.resize(1000, 750)
-        self.plotter = QtInteractor(self, auto_update=False)
-        self.setCentralWidget(self.plotter)
-        self.plotter.set_background("white")
-        self.plotter.add_mesh(
-            _polylines(chains), color="steelblue", line_width=4, render_lines_as_tubes=True, name=CA_TRACE_ACTOR
-        )
-        self.plotter.reset_camera()
+        self.document = document if document is not None else Document()
+        self.document.setParent(self)
+        self.settings = QSettings(APP_NAME, APP_NAME)
+        self.resize(1400, 900)
+        self.setAcceptDrops(True)
 
-        quit_action = QAction("&Quit", self)
-        quit_action.setShortcut(QKeySequence.StandardKey.Quit)
-        quit_action.triggered.connect(self.close)
-        self.menuBar().addMenu("&File").addAction(quit_action)
+        self.plotter = QtInteractor(self, auto_update=False)
+        self.plotter.setAcceptDrops(False)  # dropped files go to the window, which opens them
+        self.plotter.iren.clear_key_event_callbacks()  # no pyvista key bindings ('q' would close the view)
+        self._swallow_style_keys()
+        self.plotter.enable_anti_aliasing("fxaa")
+        self.setCentralWidget(self.plotter)
+        self.scene = Scene(self.document, self.plotter)
+        self.controller = DragController(self.document)
+        self.pointer = PointerAdapter(self.plotter, self._on_pointer)
+
+        self.dimension_panel = RibbonDimensionPanel(self.document)
+        self.display_panel = DisplayPanel(self.scene)
+        self.history = QUndoView(self.document.undo_stack)
+        self.history.setEmptyLabel("<structure as read>")
+        docks = [self._dock("Ribbon dimension", self.dimension_panel), self._dock("Display", self.display_panel),
+                 self._dock("Undo history", self.history)]
+        self._create_actions()
+        self._create_menus(docks)
+        self._create_status_bar()
+
+        self.document.fileChanged.connect(self._update_title)
+        self.document.loaded.connect(self._update_status)
+        self.document.levelChanged.connect(self._update_status)
+        self.document.segmentChanged.connect(self._update_status)
+        self.document.picked.connect(self._update_status)
+        self._update_title()
+        self._update_status()
+
+    # ------------------------------------------------------------------ files
+
+    def open_file(self, path: Path) -> bool:
+        """Open ``path`` after asking about unsaved edits; a bad file is reported in a dialog."""
+        if not self.maybe_save():
+            return False
+        try:
+            self.document.open(Path(path))
+        except StructureError as error:
+            QMessageBox.critical(self, APP_NAME, str(error))
+            return False
+        self._add_recent(Path(path))
+        return True
+
+    def save(self) -> bool:
+        """Save to the file chosen by the last Save As; the first Save of a file asks where."""
+        if self.document.save_path is None:
+            return self.save_as()
+        return self._write(self.document.save_path)
+
+    def save_as(self) -> bool:
+        """Ask for a file name (PDB or mmCIF by its extension) and save there."""
+        source = self.document.path
+        folder = Path.home() if source is None or source.parent == EXAMPLES_DIR else source.parent
+        stem = source.name.split(".")[0] if source is not None else "structure"
+        suffix = ".cif" if self.document.structure.source_format == "mmcif" else ".pdb"
+        name, chosen = QFileDialog.getSaveFileName(self, "Save As", str(folder / f"{stem}_edited{suffix}"),
+                                                   ";;".join(SAVE_FILTERS))
+        if not name:
+            return False
+        path = Path(name)
+        if not path.name.lower().endswith(SAVE_SUFFIXES):
+            path = path.with_name(path.name + SAVE_FILTERS.get(chosen, suffix))
+        return self._write(path)  # the dialog has asked before replacing a file
+
+    def export_image(self, path: Path | None = None) -> bool:
+        """Save the 3D view as a PNG image (asks for the name when ``path`` is None)."""
+        if path is None:
+            name, _ = QFileDialog.getSaveFileName(self, "Export Image", str(Path.home() / "ribbonwave.png"),
+                                                  "PNG image (*.png)")
+            if not name:
+                return False
+            path = Path(name) if name.lower().endswith(".png") else Path(name + ".png")
+        if not self._view_image().save(str(path), "PNG"):
+            QMessageBox.critical(self, APP_NAME, f"cannot write {path}")
+            return False
+        return True
+
+    def maybe_save(self) -> bool:
+        """True when it is fine to drop the document: no unsaved edits, saved, or discarded."""
+        if not self.document.modified:
+            return True
+        name = self.document.path.name if self.document.path else "the structure"
+        answer = QMessageBox.question(
+            self, APP_NAME, f"Save the changes to {name}?",
+            QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel,
+        )
+        if answer == QMessageBox.StandardButton.Save:
+            return self.save()
+        return answer == QMessageBox.StandardButton.Discard
 
     def save_screenshot(self, path: Path) -> None:
-        """Render the view and save an image of the whole window to ``path`` as PNG.
-
-        Raises
-        ------
-        OSError
-            The image cannot be written.
-        """
-        self.plotter.render()
-        if not self.grab().save(str(path), "PNG"):
+        """Render the window, 3D view included, to a PNG image (raises OSError)."""
+        if not self.grab_window().save(str(path), "PNG"):
             raise OSError(f"cannot write {path}")
 
+    def grab_window(self) -> QImage:
+        """An image of the whole window with the freshly rendered 3D view painted in."""
+        image = self.grab().toImage()
+        view = self._view_image()
+        painter = QPainter(image)
+        corner = self.plotter.mapTo(self, QPoint(0, 0))
+        painter.drawImage(corner, view.scaled(self.plotter.size()))
+        painter.end()
+        return image
+
+    # ------------------------------------------------------------------ events
+
     def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802 (Qt override)
-        """Release the VTK render window with the window."""
+        """Ask about unsaved edits; then release the VTK render window with the window."""
+        if not self.maybe_save():
+            event.ignore()
+            return
+        self.pointer.close()
         self.plotter.close()
         super().closeEvent(event)
+
+    def dragEnterEvent(self, event: QDragEnterEvent) -> None:  # noqa: N802 (Qt override)
+        if any(url.isLocalFile() for url in event.mimeData().urls()):
+            event.acceptProposedAction()
+
+    def dropEvent(self, event: QDropEvent) -> None:  # noqa: N802 (Qt override)
+        files = [Path(url.toLocalFile()) for url in event.mimeData().urls() if url.isLocalFile()]
+        if files:
+            event.acceptProposedAction()
+            self.open_file(files[0])
+
+    # ------------------------------------------------------------------ building
+
+    def _dock(self, title: str, widget: QWidget) -> QDockWidget:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(title)
+        dock.setWidget(widget)
+        self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
+        return dock
+
+    def _create_actions(self) -> None:
+        style = self.style()
+        icon = style.standardIcon
+        pixmap = QStyle.StandardPixmap
+        self.open_action = self._action("&Open…", QKeySequence.StandardKey.Open, self._open_dialog,
+                                        icon(pixmap.SP_DialogOpenButton))
+        self.save_action = self._action("&Save", QKeySequence.StandardKey.Save, self.save,
+                                        icon(pixmap.SP_DialogSaveButton))
+        self.save_as_action = self._action("Save &As…", QKeySequence.StandardKey.SaveAs, self.save_as)
+        self.export_action = self._action("&Export Image…", QKeySequence("Ctrl+E"), lambda: self.export_image())
+        self.quit_action = self._action("&Quit", QKeySequence.StandardKey.Quit, self.close)
+        stack = self.document.undo_stack
+        self.undo_action = stack.createUndoAction(self, "&Undo")
+        self.undo_action.setShortcut(QKeySequence.StandardKey.Undo)
+        self.undo_action.setIcon(icon(pixmap.SP_ArrowBack))
+        self.undo_action.setIconText("Undo")  # the toolbar keeps a short label; the menu names the edit
+        self.redo_action = stack.createRedoAction(self, "&Redo")
+        self.redo_action.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence.StandardKey.Redo])
+        self.redo_action.setIcon(icon(pixmap.SP_ArrowForward))
+        self.redo_action.setIconText("Redo")
+        self.cancel_action = self._action("Cancel Drag / Deselect", QKeySequence(Qt.Key.Key_Escape), self._cancel)
+        self.reset_view_action = self._action("&Reset View", QKeySequence("Ctrl+R"), self._reset_view,
+                                              icon(pixmap.SP_BrowserReload))
+        self.mode_actions = QActionGroup(self)
+        for mode, key in ((Mode.POINT, "M"), (Mode.CURVE, "T")):
+            action = self._action(mode.value[0].upper() + mode.value[1:], QKeySequence(key),
+                                  lambda _=False, mode=mode: setattr(self.controller, "mode", mode))
+            action.setCheckable(True)
+            action.setChecked(mode is self.controller.mode)
+            self.mode_actions.addAction(action)
+
+    def _action(self, text: str, shortcut: QKeySequence | QKeySequence.StandardKey, slot: object,
+                icon: object = None) -> QAction:
+        action = QAction(text, self)
+        action.setShortcut(shortcut)
+        action.triggered.connect(slot)
+        if icon is not None:
+            action.setIcon(icon)
+        self.addAction(action)  # shortcuts work wherever the focus is, the 3D view included
+        return action
+
+    def _create_menus(self, docks: list[QDockWidget]) -> None:
+        menu = self.menuBar()
+        file_menu = menu.addMenu("&File")
+        file_menu.addAction(self.open_action)
+        self.recent_menu = file_menu.addMenu("Open &Recent")
+        self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
+        file_menu.addSeparator()
+        file_menu.addActions([self.save_action, self.save_as_action, self.export_action])
+        file_menu.addSeparator()
+        file_menu.addAction(self.quit_action)
+        edit_menu = menu.addMenu("&Edit")
+        edit_menu.addActions([self.undo_action, self.redo_action, self.cancel_action])
+        edit_menu.addSeparator()
+        edit_menu.addActions(self.mode_actions.actions())
+        view_menu = menu.addMenu("&View")
+        view_menu.addAction(self.reset_view_action)
+        view_menu.addSeparator()
+        view_menu.addActions([dock.toggleViewAction() for dock in docks])
+        toolbar = self.addToolBar("Main")
+        toolbar.setObjectName("Main")
+        toolbar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+        toolbar.addActions([self.open_action, self.save_action])
+        toolbar.addSeparator()
+        toolbar.addActions([self.undo_action, self.redo_action])
+        toolbar.addSeparator()
+        toolbar.addActions(self.mode_actions.actions())
+        toolbar.addSeparator()
+        toolbar.addAction(self.reset_view_action)
+
+    def _create_status_bar(self) -> None:
+        self.status_labels = {key: QLabel() for key in ("file", "segment", "level", "pick")}
+        for key, label in self.status_labels.items():
+            self.statusBar().addWidget(label, 1 if key == "pick" else 0)
+
+    def _swallow_style_keys(self) -> None:
+        """Keep VTK's one-letter camera-style keys ('w' wireframe, 'e' exit, ...) away from the view."""
+        interactor = self.plotter.iren.interactor
+        tag = interactor.AddObserver("CharEvent", lambda caller, _: caller.GetCommand(tag).SetAbortFlag(1), PRIORITY)
+
+    # ------------------------------------------------------------------ slots
+
+    def _on_pointer(self, event: PointerEvent) -> bool:
+        return self.controller.handle(event)
+
+    def _cancel(self) -> None:
+        if self.controller.dragging:
+            self.controller.cancel()
+        elif self.document.model is not None:
+            self.document.pick_point(None)
+
+    def _reset_view(self) -> None:
+        self.scene.reset_camera()
+        self.plotter.render()
+
+    def _open_dialog(self) -> None:
+        folder = str(self.document.path.parent) if self.document.path else str(Path.home())
+        name, _ = QFileDialog.getOpenFileName(self, "Open Structure", folder, STRUCTURE_FILTER)
+        if name:
+            self.open_file(Path(name))
+
+    def _write(self, path: Path) -> bool:
+        try:
+            self.document.save(path, overwrite=True)
+        except (StructureError, OSError) as error:
+            QMessageBox.critical(self, APP_NAME, str(error))
+            return False
+        self._add_recent(path)
+        return True
+
+    def _recent_files(self) -> list[str]:
+        value = self.settings.value(RECENT_KEY, [])
+        return [value] if isinstance(value, str) else list(value or [])
+
+    def _add_recent(self, path: Path) -> None:
+        name = str(path.resolve())
+        files = [name] + [f for f in self._recent_files() if f != name]
+        self.settings.setValue(RECENT_KEY, files[:MAX_RECENT])
+
+    def _fill_recent_menu(self) -> None:
+        self.recent_menu.clear()
+        for name in self._recent_files():
+            action = self.recent_menu.addAction(name)
+            action.triggered.connect(lambda _=False, name=name: self.open_file(Path(name)))
+        self.recent_menu.addSeparator()
+        clear = self.recent_menu.addAction("Clear Menu")
+        clear.triggered.connect(lambda: self.settings.setValue(RECENT_KEY, []))
+
+    def _update_title(self) -> None:
+        path = self.document.path
+        self.setWindowTitle(f"{path.name if path else 'untitled'}[*] — {APP_NAME}")
+        self.setWindowModified(self.document.modified)
+        self._update_status()
+
+    def _update_status(self) -> None:
+        document = self.document
+        labels = self.status_labels
+        if document.model is None:
+            labels["file"].setText("no structure")
+            return
+        structure = document.structure
+        labels["file"].setText(f"{document.path.name if document.path else ''}  ({structure.entry_id})")
+        labels["segment"].setText(f"chain {document.segment_label(document.segment)}")
+        labels["level"].setText(f"level {document.shown_level():.2f} / {document.max_level:.2f}")
+        pick = document.pick
+        labels["pick"].setText(
+            "Click a control point to pick it; drag it to edit. Drag elsewhere to turn the view." if pick is None
+            else f"point {pick.index} moves {len(pick.residues)} residues: {document.residue_range(pick.residues)}"
+        )
+
+    def _view_image(self) -> QImage:
+        """The 3D view rendered now, as an image."""
+        pixels = np.ascontiguousarray(self.plotter.screenshot(return_img=True))
+        height, width = pixels.shape[:2]
+        return QImage(pixels.data, width, height, 3 * width, QImage.Format.Format_RGB888).copy()

@@ -1,78 +1,354 @@
-"""The editor window on the bundled example, and the ``ribbonwave`` command that opens it."""
+"""The editor window under Xvfb: the view follows the document, mouse drags edit, files round-trip.
 
-import re
+Drags go through the same path as the mouse: events invoked on the VTK interactor of the
+``QtInteractor`` at the display position of a control-point sphere.
+"""
+
 from pathlib import Path
 
 import numpy as np
 import pytest
-from PySide6.QtGui import QAction, QImage
-from PySide6.QtWidgets import QApplication
+from PySide6.QtCore import QMimeData, QPointF, Qt, QUrl
+from PySide6.QtGui import QDropEvent, QImage
+from PySide6.QtWidgets import QApplication, QFileDialog
 from pytestqt.qtbot import QtBot
 
-from app import DEFAULT_STRUCTURE
+from app import DEFAULT_STRUCTURE, molecule
 from app.cli import COMMANDS, main
-from app.main_window import CA_TRACE_ACTOR, MainWindow, read_ca_chains
+from app.document import Document
+from app.drag import Mode
+from app.main_window import RECENT_KEY, MainWindow
+from app.molecule import Colouring
+from app.panels import STEPS_PER_LEVEL
+from app.scene import TUBE_SIDES, Layer
+from core.splines import spline_space
+from core.structure import read_structure
 
-UBIQUITIN_RESIDUES = 76
 DATA = Path(__file__).resolve().parent.parent / "data"
+SPHERE_VERTICES = 42
 
 
-def _pixels(image: QImage) -> np.ndarray:
-    """RGB pixels of ``image``, shape (height, width, 3)."""
-    image = image.convertToFormat(QImage.Format.Format_RGB888)
-    rows = np.frombuffer(image.constBits(), dtype=np.uint8).reshape(image.height(), image.bytesPerLine())
-    return rows[:, : 3 * image.width()].reshape(image.height(), image.width(), 3)
-
-
-def _count_blue(pixels: np.ndarray) -> int:
-    """Number of pixels with the blue hue of the Cα trace (the background is white, the chrome grey)."""
-    red, blue = pixels[..., 0].astype(int), pixels[..., 2].astype(int)
-    return int(np.count_nonzero(blue - red > 40))
+def _window(qtbot: QtBot, path: Path) -> MainWindow:
+    document = Document()
+    document.open(path)
+    window = MainWindow(document)
+    qtbot.addWidget(window)  # closed (answering 'Discard'), and so its plotter too, after the test
+    window.show()
+    qtbot.waitExposed(window)
+    window.plotter.render()
+    return window
 
 
 @pytest.fixture
 def window(qtbot: QtBot) -> MainWindow:
-    window = MainWindow(DEFAULT_STRUCTURE, read_ca_chains(DEFAULT_STRUCTURE))
-    qtbot.addWidget(window)  # closed, and so its plotter too, after the test
-    window.show()
-    qtbot.waitExposed(window)
-    return window
+    return _window(qtbot, DATA / "1UBQ.pdb.gz")
 
 
-def test_bundled_example_is_ubiquitin() -> None:
-    (chain,) = read_ca_chains(DEFAULT_STRUCTURE)
-    assert chain.shape == (UBIQUITIN_RESIDUES, 3)
+def _display(window: MainWindow, point: np.ndarray) -> tuple[int, int]:
+    renderer = window.plotter.renderer
+    renderer.SetWorldPoint(*point, 1.0)
+    renderer.WorldToDisplay()
+    x, y, _ = renderer.GetDisplayPoint()
+    return round(x), round(y)
 
 
-def test_one_trace_per_protein_chain() -> None:
-    chains = read_ca_chains(DATA / "4HHB.pdb.gz")  # haemoglobin: two alpha and two beta chains
-    assert [chain.shape for chain in chains] == [(141, 3), (146, 3), (141, 3), (146, 3)]
+def _mouse_drag(window: MainWindow, start: tuple[int, int], offset: tuple[int, int], steps: int = 6) -> None:
+    """Press, move in ``steps`` and release the left button on the view's VTK interactor."""
+    interactor = window.plotter.iren.interactor
+    interactor.SetEventInformation(*start)
+    interactor.InvokeEvent("LeftButtonPressEvent")
+    for k in range(1, steps + 1):
+        interactor.SetEventInformation(start[0] + offset[0] * k // steps, start[1] + offset[1] * k // steps)
+        interactor.InvokeEvent("MouseMoveEvent")
+    interactor.InvokeEvent("LeftButtonReleaseEvent")
 
 
-def test_window_renders_the_ca_trace(window: MainWindow) -> None:
-    assert window.windowTitle() == "ribbonwave — 1UBQ.pdb"
-    actor = window.plotter.actors[CA_TRACE_ACTOR]
-    assert actor.GetVisibility()
-    assert actor.GetMapper().GetInput().GetNumberOfPoints() == UBIQUITIN_RESIDUES
+def _drag_control_point(window: MainWindow, which: int, offset: tuple[int, int] = (40, 25)) -> int:
+    """Drag the ``which``-th shown control point; returns its index in the level curve."""
+    curve = window.document.level_curve()
+    shown = window.scene.shown_control_points()
+    index = int(shown[which])
+    _mouse_drag(window, _display(window, curve.control_points[index]), offset)
+    return index
+
+
+def _moved_residues(document: Document, before: np.ndarray) -> np.ndarray:
+    rows = np.flatnonzero(np.any(document.model.coords != before, axis=1))
+    return np.unique(document.structure.atom_residue[rows])
+
+
+def _pixels(image: QImage) -> np.ndarray:
+    image = image.convertToFormat(QImage.Format.Format_RGB888)
+    rows = np.frombuffer(image.constBits(), dtype=np.uint8).reshape(image.height(), image.bytesPerLine())
+    return rows[:, : 3 * image.width()].reshape(image.height(), image.width(), 3).astype(int)
+
+
+def _colour_counts(pixels: np.ndarray) -> dict[str, int]:
+    """Pixels of the secondary-structure colours, by hue whatever the shading."""
+    r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
+    bright = r > 90
+    return {
+        "helix": int(np.count_nonzero(bright & (r - g > 70) & (r - b > 50) & (b > g))),  # (222, 66, 91)
+        "sheet": int(np.count_nonzero(bright & (g > 0.65 * r) & (g < 0.9 * r) & (b < 0.2 * r))),  # (246, 190, 0)
+    }
+
+
+# ------------------------------------------------------------------ the view follows the document
+
+
+def test_bundled_example_is_ubiquitin(qapp: QApplication) -> None:
+    structure = read_structure(DEFAULT_STRUCTURE)
+    assert structure.entry_id == "1UBQ" and structure.n_residues == 76
+
+
+def test_window_shows_the_structure(window: MainWindow) -> None:
+    assert window.windowTitle() == "1UBQ.pdb.gz[*] — ribbonwave" and not window.isWindowModified()
+    tube = window.scene.meshes["tube"]
+    assert tube.n_points == (76 * 6 + 1) * TUBE_SIDES + 2 * (TUBE_SIDES + 1)
+    assert window.plotter.actors["tube"].GetVisibility()
+    colours = {tuple(c) for c in tube.point_data["colours"]}
+    assert set(molecule.SS_COLOURS.values()) <= colours
+    assert "ions" not in window.plotter.actors  # ubiquitin has none
+    assert window.status_labels["segment"].text() == "chain A  MET1–GLY76 (76 residues)"
+    assert window.history.model().rowCount() == 1  # "<structure as read>"
+
+
+@pytest.mark.parametrize("level", [0.0, 2.0, 3.0, 3.5, 5.0, "max"])
+def test_slider_shows_the_curve_and_control_points_of_the_level(window: MainWindow, level: object) -> None:
+    document, panel = window.document, window.dimension_panel
+    value = round((document.max_level if level == "max" else level) * STEPS_PER_LEVEL)
+    panel.slider.setValue(value)
+    assert document.level == (document.max_level if level == "max" else value / STEPS_PER_LEVEL)
+    ribbon = document.model.ribbons[0]
+    points, j = ribbon.control_points(document.level)
+    path = document.paths[0]
+    np.testing.assert_allclose(window.scene.meshes["curve"].points, spline_space(j).evaluate(points, path.curve_u),
+                               atol=1e-5)  # float32 in VTK
+    shown = window.scene.shown_control_points()
+    knots = spline_space(j).knots  # basis function k lives on [knots[k], knots[k + 4]]
+    first, last = path.u[0], path.u[-1]  # the residues' stretch of the padded curve
+    reach = np.flatnonzero((knots[4:] > first) & (knots[:-4] < last))
+    assert np.array_equal(shown, reach)  # spheres for the points that shape residues, none for the padding
+    expected = len(reach)
+    if level == "max":
+        assert expected == 76 + 3  # one per peptide plane and two per terminus
+    if level in (0.0, 2.0):
+        assert expected == 2**j + 3
+    assert window.scene.meshes["control_points"].n_points == expected * SPHERE_VERTICES
+    centres = window.scene.meshes["control_points"].points.reshape(expected, SPHERE_VERTICES, 3).mean(axis=1)
+    np.testing.assert_allclose(centres, points[shown], atol=1e-4)
+    assert panel.segments_text.text().endswith(f"2^{j} = {2**j}")
+    assert panel.points_text.text() == f"{expected} shown of {2**j + 3}"
+
+
+def test_integer_levels_only(window: MainWindow) -> None:
+    panel = window.dimension_panel
+    panel.integers.setChecked(True)
+    panel.slider.setValue(round(2.7 * STEPS_PER_LEVEL))
+    assert window.document.level == 3.0 and panel.slider.value() == 3 * STEPS_PER_LEVEL
+    panel.slider.setValue(round(6.2 * STEPS_PER_LEVEL))
+    assert window.document.level == window.document.max_level  # log2 76 = 6.25, the original curve
+    panel.analysis.setChecked(False)
+    assert not panel.slider.isEnabled() and window.document.shown_level() == window.document.max_level
+
+
+def test_large_multichain_entry(qtbot: QtBot) -> None:
+    window = _window(qtbot, DATA / "4YVS.cif.gz")
+    document, panel = window.document, window.dimension_panel
+    assert panel.segment.count() == 20 and panel.segment.isEnabled()
+    panel.segment.setCurrentIndex(5)  # chain G
+    assert document.segment == 5 and window.status_labels["segment"].text().startswith("chain G")
+    panel.slider.setValue(3 * STEPS_PER_LEVEL)
+    samples = np.vstack([document.level_curve(g).samples for g in range(20)])
+    np.testing.assert_allclose(window.scene.meshes["curve"].points, samples, atol=1e-4)
+    assert all(document.level_curve(g).n_segments == 8 for g in range(20))
+    assert len(window.scene.shown_control_points()) == 11
+    points = document.model.ribbons[5].control_points(3.0)[0]
+    centres = window.scene.meshes["control_points"].points.reshape(11, SPHERE_VERTICES, 3).mean(axis=1)
+    np.testing.assert_allclose(centres, points, atol=1e-4)
+
+
+def test_layers_colours_and_fat_helices(window: MainWindow) -> None:
+    panel = window.display_panel
+    panel.layer_boxes[Layer.ATOMS].setChecked(True)
+    assert window.plotter.actors["atoms"].GetVisibility()
+    panel.layer_boxes[Layer.TUBE].setChecked(False)
+    assert not window.plotter.actors["tube"].GetVisibility()
+    panel.layer_boxes[Layer.CONTROL_POINTS].setChecked(False)
+    assert not window.plotter.actors["control_points"].GetVisibility()
+    panel.colouring.setCurrentIndex(panel.colouring.findData(Colouring.RESIDUE_TYPE))
+    colours = window.scene.meshes["tube"].point_data["colours"]
+    assert tuple(colours[0]) == molecule.RESIDUE_CLASSES["hydrophobic"][0]  # Met1
+    assert panel.legend_layout.rowCount() == len(molecule.RESIDUE_CLASSES)
+    tube = window.scene.meshes["tube"]
+    centre = window.document.paths[0]
+    before = np.array(tube.points)
+    panel.fat.setChecked(True)
+    helix = np.flatnonzero(window.document.structure.segments[0].ss == "H")[3]  # a residue inside the helix
+    ring = helix * centre.rings_per_residue + centre.rings_per_residue // 2
+    centres, _ = centre.centres(window.document.model.ribbons[0].points, np.array([ring]))
+    radius = np.linalg.norm(tube.points[ring * TUBE_SIDES] - centres[0])
+    assert radius == pytest.approx(1.5, abs=1e-4) and not np.allclose(before, tube.points)
+
+
+# ------------------------------------------------------------------ editing with the mouse
+
+
+@pytest.mark.parametrize(("level", "expected"), [("max", 4), (5.0, 16), (4.0, 32)])
+def test_dragging_a_control_point_edits_the_structure(
+    window: MainWindow, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, level: object, expected: int
+) -> None:
+    document = window.document
+    document.set_level(document.max_level if level == "max" else level)
     window.plotter.render()
-    assert _count_blue(window.plotter.screenshot(return_img=True)) > 1000
+    original = document.model.coords.copy()
+    index = _drag_control_point(window, len(window.scene.shown_control_points()) // 2)
+
+    assert document.pick is not None and document.pick.index == index
+    assert document.undo_stack.count() == 1  # one drag, one undo step
+    assert document.undo_stack.text(0) == f"Move point {index} at level {document.shown_level():.2f}"
+    moved = _moved_residues(document, original)
+    assert len(moved) == expected  # 4 residues at full resolution, twice as many one level down (J = 7 here)
+    assert np.array_equal(moved, document.structure.segments[0].residue_index[document.pick.residues])
+    owned = np.isin(document.structure.atom_residue, moved)
+    assert np.array_equal(document.model.coords[~owned], original[~owned])  # all other atoms bit-identical
+    assert np.all(np.any(document.model.coords[owned] != original[owned], axis=1))
+    # the view followed: the tube and the atoms of the moved residues
+    atoms = window.scene.meshes["atoms"].points
+    np.testing.assert_allclose(atoms, document.model.coords, atol=1e-4)
+    assert window.isWindowModified()
+    assert window.status_labels["pick"].text().startswith(f"point {index} moves {expected} residues")
+    edited = document.model.coords.copy()
+    tube_after = np.array(window.scene.meshes["tube"].points)
+
+    window.undo_action.trigger()
+    assert np.array_equal(document.model.coords, original) and not window.isWindowModified()
+    window.redo_action.trigger()
+    assert np.array_equal(document.model.coords, edited)
+    np.testing.assert_array_equal(window.scene.meshes["tube"].points, tube_after)
+
+    target = tmp_path / "edited.cif"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *args, **kwargs: (str(target), ""))
+    window.save_action.trigger()  # the first Save asks for a file name
+    np.testing.assert_allclose(read_structure(target).coords, edited, atol=6e-4)
+    assert document.save_path == target and not window.isWindowModified()
 
 
-def test_quit_closes_window_and_plotter(qtbot: QtBot, window: MainWindow) -> None:
-    (quit_action,) = [action for action in window.findChildren(QAction) if action.text() == "&Quit"]
-    quit_action.trigger()
+def test_undoing_the_tube_is_exact(window: MainWindow) -> None:
+    tube = np.array(window.scene.meshes["tube"].points)
+    _drag_control_point(window, 4)
+    assert not np.array_equal(window.scene.meshes["tube"].points, tube)
+    window.undo_action.trigger()
+    np.testing.assert_array_equal(window.scene.meshes["tube"].points, tube)
+
+
+def test_tugging_the_curve_with_the_mouse(window: MainWindow) -> None:
+    document = window.document
+    window.mode_actions.actions()[1].trigger()
+    assert window.controller.mode is Mode.CURVE
+    original = document.model.coords.copy()
+    sample = document.level_curve().samples[120]
+    _mouse_drag(window, _display(window, sample), (0, 40))
+    assert document.undo_stack.count() == 1 and document.undo_stack.text(0).startswith("Tug curve at A:")
+    assert 0 < len(_moved_residues(document, original)) < 76
+
+
+def test_a_drag_beside_the_points_turns_the_camera(window: MainWindow) -> None:
+    camera = window.plotter.camera.position
+    _mouse_drag(window, (5, 5), (120, 60))
+    assert window.plotter.camera.position != camera
+    assert window.document.undo_stack.count() == 0 and window.document.pick is None
+
+
+def test_escape_cancels_a_drag(window: MainWindow) -> None:
+    document = window.document
+    original = document.model.coords.copy()
+    point = document.level_curve().control_points[int(window.scene.shown_control_points()[6])]
+    start = _display(window, point)
+    interactor = window.plotter.iren.interactor
+    interactor.SetEventInformation(*start)
+    interactor.InvokeEvent("LeftButtonPressEvent")
+    interactor.SetEventInformation(start[0] + 50, start[1])
+    interactor.InvokeEvent("MouseMoveEvent")
+    assert not np.array_equal(document.model.coords, original)
+    window.cancel_action.trigger()
+    interactor.InvokeEvent("LeftButtonReleaseEvent")
+    assert np.array_equal(document.model.coords, original) and document.undo_stack.count() == 0
+
+
+# ------------------------------------------------------------------ files
+
+
+def test_closing_with_unsaved_edits_asks_first(qtbot: QtBot, window: MainWindow, questions) -> None:
+    _drag_control_point(window, 3)
+    questions.answer = questions.answer.Cancel
+    window.close()
+    assert window.isVisible() and questions.asked == ["Save the changes to 1UBQ.pdb.gz?"]
+    questions.answer = questions.answer.Discard
+    window.close()
     qtbot.waitUntil(lambda: not window.isVisible())
     assert window.plotter.render_window is None
 
 
-def test_screenshot_shows_the_trace(qapp: QApplication, tmp_path: Path) -> None:
+def test_opening_another_file_asks_and_bad_files_are_reported(window: MainWindow, questions, errors) -> None:
+    _drag_control_point(window, 3)
+    questions.answer = questions.answer.Cancel
+    assert not window.open_file(DATA / "1TIM.pdb.gz")
+    assert window.document.structure.entry_id == "1UBQ"
+    questions.answer = questions.answer.Discard
+    assert not window.open_file(DATA / "missing.pdb")
+    assert errors == [f"{DATA / 'missing.pdb'}: no such file"] and window.document.structure.entry_id == "1UBQ"
+    assert window.open_file(DATA / "1TIM.pdb.gz")
+    assert window.document.structure.entry_id == "1TIM" and window.document.undo_stack.count() == 0
+    assert window.dimension_panel.segment.count() == 2
+    assert window.windowTitle() == "1TIM.pdb.gz[*] — ribbonwave"
+    assert window._recent_files()[0] == str((DATA / "1TIM.pdb.gz").resolve())  # kept in the temporary settings
+    assert window.settings.value(RECENT_KEY)
+
+
+def test_save_never_overwrites_the_input_without_asking(window: MainWindow, tmp_path: Path, monkeypatch) -> None:
+    source = tmp_path / "input.pdb"
+    source.write_bytes((DATA / "1UBQ.pdb.gz").read_bytes())
+    assert window.open_file(source)
+    _drag_control_point(window, 3)
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *args, **kwargs: ("", ""))  # cancelled
+    assert not window.save()
+    assert source.read_bytes() == (DATA / "1UBQ.pdb.gz").read_bytes()
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *args, **kwargs: (str(tmp_path / "out"), "mmCIF (*.cif *.cif.gz *.mmcif)"))
+    assert window.save()
+    assert (tmp_path / "out.cif").exists() and window.document.save_path == tmp_path / "out.cif"
+    _drag_control_point(window, 5)
+    assert window.save()  # later saves go to the chosen file without asking
+    np.testing.assert_allclose(read_structure(tmp_path / "out.cif").coords, window.document.model.coords, atol=6e-4)
+
+
+def test_dropping_a_file_opens_it(window: MainWindow) -> None:
+    mime = QMimeData()
+    mime.setUrls([QUrl.fromLocalFile(str(DATA / "4HHB.pdb.gz"))])
+    event = QDropEvent(QPointF(20, 20), Qt.DropAction.CopyAction, mime, Qt.MouseButton.NoButton,
+                       Qt.KeyboardModifier.NoModifier)
+    window.dropEvent(event)
+    assert window.document.structure.entry_id == "4HHB"
+    assert window.plotter.actors["ligand_balls"].GetVisibility()  # the haems, ball-and-stick
+
+
+def test_export_image(window: MainWindow, tmp_path: Path) -> None:
+    assert window.export_image(tmp_path / "view.png")
+    image = QImage(str(tmp_path / "view.png"))
+    assert image.width() == window.plotter.width()
+    assert _colour_counts(_pixels(image))["helix"] > 200
+
+
+# ------------------------------------------------------------------ the command line
+
+
+def test_screenshot_shows_the_tube_in_its_colours(qapp: QApplication, tmp_path: Path) -> None:
     shot = tmp_path / "shot.png"
-    assert main(["--screenshot", str(shot)]) == 0
-    image = QImage(str(shot))
-    assert not image.isNull()
-    pixels = _pixels(image)
-    assert len(np.unique(pixels.reshape(-1, 3), axis=0)) > 1
-    assert _count_blue(pixels) > 1000
+    assert main([str(DATA / "1UBQ.pdb.gz"), "--screenshot", str(shot), "--level", "3"]) == 0
+    pixels = _pixels(QImage(str(shot)))
+    assert pixels.shape[:2] == (900, 1400)
+    counts = _colour_counts(pixels)
+    assert counts["helix"] > 1000 and counts["sheet"] > 1000, counts
 
 
 @pytest.mark.parametrize("content", [None, "not a structure\n"], ids=["missing", "not-a-structure"])
@@ -85,14 +361,14 @@ def test_unreadable_file_is_a_one_line_error(
     assert main([str(path)]) == 1
     out, err = capsys.readouterr()
     assert out == ""
-    assert err.startswith("ribbonwave: error: ")
-    assert str(path) in err
-    assert err.count("\n") == 1
+    assert err.startswith("ribbonwave: error: ") and str(path) in err and err.count("\n") == 1
 
 
-def test_unwritable_screenshot_is_a_one_line_error(
+def test_bad_level_and_unwritable_screenshot_are_one_line_errors(
     qapp: QApplication, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    assert main(["--level", "-1"]) == 1
+    assert capsys.readouterr().err == "ribbonwave: error: --level must be >= 0; got -1\n"
     shot = tmp_path / "no-such-folder" / "shot.png"
     assert main(["--screenshot", str(shot)]) == 1
     assert capsys.readouterr().err == f"ribbonwave: error: cannot write {shot}\n"
@@ -104,4 +380,4 @@ def test_help_lists_the_commands(capsys: pytest.CaptureFixture[str]) -> None:
     assert exit_info.value.code == 0
     out = capsys.readouterr().out
     for name in COMMANDS:
-        assert re.search(rf"^ +{name} ", out, re.MULTILINE)
+        assert f"    {name} " in out or f"    {name}\n" in out

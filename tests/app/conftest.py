@@ -1,0 +1,55 @@
+"""Fixtures of the app tests: private settings, recorded message boxes, documents on real entries."""
+
+from pathlib import Path
+
+import pytest
+from PySide6.QtCore import QSettings
+from PySide6.QtWidgets import QApplication, QMessageBox
+
+from app.document import Document
+
+DATA = Path(__file__).resolve().parent.parent / "data"
+
+
+@pytest.fixture(autouse=True)
+def private_settings(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Recent files and other settings go to a temporary folder, never the user's."""
+    folder = tmp_path_factory.mktemp("settings")
+    for fmt in (QSettings.Format.NativeFormat, QSettings.Format.IniFormat):
+        QSettings.setPath(fmt, QSettings.Scope.UserScope, str(folder))
+    return folder
+
+
+class Questions:
+    """Stands in for ``QMessageBox.question``: records the questions, gives a set answer."""
+
+    def __init__(self) -> None:
+        self.asked: list[str] = []
+        self.answer = QMessageBox.StandardButton.Discard
+
+    def __call__(self, parent: object, title: str, text: str, *args: object) -> QMessageBox.StandardButton:
+        self.asked.append(text)
+        return self.answer
+
+
+@pytest.fixture(autouse=True)
+def questions(monkeypatch: pytest.MonkeyPatch) -> Questions:
+    """No modal dialog may block a test: questions are answered 'Discard' unless a test says otherwise."""
+    recorder = Questions()
+    monkeypatch.setattr(QMessageBox, "question", recorder)
+    return recorder
+
+
+@pytest.fixture
+def errors(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """Messages of ``QMessageBox.critical`` dialogs, which are not shown."""
+    shown: list[str] = []
+    monkeypatch.setattr(QMessageBox, "critical", lambda parent, title, text, *args: shown.append(text))
+    return shown
+
+
+@pytest.fixture
+def ubiquitin(qapp: QApplication) -> Document:
+    document = Document()
+    document.open(DATA / "1UBQ.pdb.gz")
+    return document
