@@ -14,7 +14,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
-from app import DEFAULT_STRUCTURE, structure_commands
+from app import DEFAULT_STRUCTURE, analysis_commands, structure_commands
 
 PROG = "ribbonwave"
 DEFAULT_COMMAND = "open"
@@ -102,6 +102,10 @@ COMMANDS: dict[str, Command] = {
                      structure_commands.curve_arguments, structure_commands.run_curve),
     "edit": Command("move one control point (or residue curve point) at a level and save the model",
                     structure_commands.edit_arguments, structure_commands.run_edit),
+    "analyze": Command("Cα–C^r deviations over many structures by decomposition step (Carson's Fig. 7)",
+                       analysis_commands.analyze_arguments, analysis_commands.run_analyze),
+    "compare": Command("superpose two chains and judge fits on fewer Cα or on low-resolution curves",
+                       analysis_commands.compare_arguments, analysis_commands.run_compare),
 }
 
 

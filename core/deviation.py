@@ -27,21 +27,25 @@ from .wavelets import smooth, split_level
 def level_residue_points(ribbon: Ribbon) -> np.ndarray:
     """Residue points of the L2-best curve of every integer level.
 
+    Every coarse control polygon ``C^j`` is refined back to the finest level (exact knot
+    insertion, ``P^J … P^(j+1) C^j``) in one upward sweep over all levels at once, so a
+    single evaluation at the residue parameters gives all the curves.
+
     Returns
     -------
     (J + 1, N, 3) float64, Å
         Row ``j`` holds ``C^r`` evaluated on the level-``j`` curve; row ``J`` is the
         original curve.
     """
-    points = ribbon.points
-    basis = spline_space(ribbon.level).design_matrix(ribbon.residue_u)
-    result = np.empty((ribbon.level + 1, len(ribbon.residue_u), 3))
-    result[ribbon.level] = basis @ points
-    for j in range(ribbon.level - 1, -1, -1):
-        points = smooth(points, j)
-        basis = basis @ level_filters(j + 1).P  # refinement identity: Phi^j(u) = Phi^(j+1)(u) P^(j+1)
-        result[j] = basis @ points
-    return result
+    finest = ribbon.level
+    coarse = [ribbon.points]  # C^J, C^(J-1), ..., C^0
+    for j in range(finest - 1, -1, -1):
+        coarse.append(smooth(coarse[-1], j))
+    refined = coarse[-1]  # columns: C^0, C^1, ... each refined to the current level
+    for j in range(1, finest + 1):
+        refined = np.hstack([level_filters(j).P @ refined, coarse[finest - j]])
+    values = spline_space(finest).design_matrix(ribbon.residue_u) @ refined
+    return values.reshape(len(ribbon.residue_u), finest + 1, 3).transpose(1, 0, 2)
 
 
 def depth_deviations(
