@@ -56,16 +56,18 @@ def vdw_radii(elements: NDArray[np.str_]) -> np.ndarray:
 def surface_atoms(atoms: AtomTable, *, exclude: NDArray[np.bool_] | None = None) -> np.ndarray:
     """Mask of the atoms that make the molecular surface.
 
-    Every non-water heavy atom of the first conformer (altloc '' or the first altloc of its
-    residue), minus ``exclude`` (e.g. a ligand whose pocket should be seen).
+    Every non-water heavy atom of the first conformer (altloc '' or the first altloc met
+    under its chain and residue number), minus ``exclude`` (e.g. a ligand whose pocket
+    should be seen).
     """
     keep = (atoms.category != "water") & ~np.isin(np.char.upper(atoms.element), ("H", "D"))
     has_alt = np.flatnonzero(atoms.altloc != "")
-    if len(has_alt):
-        residues, first = np.unique(atoms.residue[has_alt], return_index=True)
-        first_alt = dict(zip(residues.tolist(), atoms.altloc[has_alt[first]].tolist(), strict=True))
-        wanted = np.array([first_alt[r] for r in atoms.residue[has_alt].tolist()])
-        keep[has_alt] &= atoms.altloc[has_alt] == wanted
+    if len(has_alt):  # residue-level alternates are separate residues with one number
+        numbers = list(zip(atoms.chain[has_alt].tolist(), atoms.resseq[has_alt].tolist(), strict=True))
+        first_alt: dict[tuple[str, int], str] = {}
+        for number, alt in zip(numbers, atoms.altloc[has_alt].tolist(), strict=True):
+            first_alt.setdefault(number, alt)
+        keep[has_alt] &= atoms.altloc[has_alt] == np.array([first_alt[n] for n in numbers])
     if exclude is not None:
         keep &= ~np.asarray(exclude, dtype=bool)
     return keep
