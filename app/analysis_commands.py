@@ -23,6 +23,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from app.structure_commands import InputError, load
 from core.analysis import (
@@ -66,7 +67,7 @@ def analyze_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUTDIR",
                         help="folder for residues.csv, summary.csv, skipped.csv and fig7.png (created if needed)")
     parser.add_argument("--overwrite", action="store_true", help="replace those files if OUTDIR already has them")
-    parser.add_argument("--jobs", type=_positive_int, default=os.cpu_count() or 1, metavar="N",
+    parser.add_argument("--jobs", type=_positive_int, default=len(os.sched_getaffinity(0)), metavar="N",
                         help="worker processes (default: all cores)")
     parser.add_argument("--scheduler", nargs="?", const="local", metavar="ADDRESS",
                         help="run on a Dask cluster (e.g. tcp://host:8786); without ADDRESS, a local cluster "
@@ -144,8 +145,12 @@ def _run(paths: list[Path], options: AnalysisOptions, jobs: int, scheduler: str 
         context.set_forkserver_preload(["core.analysis"])
         with ProcessPoolExecutor(min(jobs, len(paths)), mp_context=context) as pool:
             futures = {pool.submit(analyse_path, path, options): index for index, path in enumerate(paths)}
-            for future in as_completed(futures):
-                yield futures[future], _result(future, paths[futures[future]])
+            try:
+                for future in as_completed(futures):
+                    yield futures[future], _result(future, paths[futures[future]])
+            except BaseException:  # Ctrl+C or an error: drop the files not started yet
+                pool.shutdown(cancel_futures=True)
+                raise
 
 
 def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: str
@@ -156,10 +161,10 @@ def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: s
         raise InputError("--scheduler needs Dask: pip install 'dask[distributed]' (the 'cluster' extra)") from None
     with contextlib.ExitStack() as stack:
         try:
+            scheduler = address
             if address == "local":
-                address = stack.enter_context(
-                    LocalCluster(n_workers=jobs, threads_per_worker=1, dashboard_address=None))
-            client = stack.enter_context(Client(address, timeout=30))
+                scheduler = stack.enter_context(LocalCluster(n_workers=jobs, threads_per_worker=1, dashboard_address=None))
+            client = stack.enter_context(Client(scheduler, timeout=10))
         except (OSError, ValueError) as error:
             raise InputError(f"cannot reach the Dask scheduler {address}: {error}") from None
         futures = client.map(analyse_path, paths, options=options, pure=False)
@@ -176,9 +181,7 @@ def _result(future, path: Path) -> FileAnalysis | SkippedFile:
         return SkippedFile(path, f"worker failed ({type(error).__name__}: {error})")
 
 
-def _progress(total: int):
-    from tqdm import tqdm
-
+def _progress(total: int) -> tqdm:
     return tqdm(total=total, unit="file", desc="analysing", file=sys.stderr, mininterval=0.5)
 
 
@@ -219,34 +222,37 @@ def summary_csv(rows: list[SummaryRow]) -> str:
 
 def summary_text(rows: list[SummaryRow], analyses: list[FileAnalysis], skipped: list[SkippedFile], folder: Path) -> str:
     """The report printed at the end of ``analyze``."""
-    n_residues = sum(len(a) for a in analyses)
     lines = [
-        f"analysed {len(analyses)} file(s), {sum(a.n_curves for a in analyses)} curves, {n_residues} residues"
+        f"analysed {len(analyses)} file(s), {sum(a.n_curves for a in analyses)} curves, "
+        f"{sum(len(a) for a in analyses)} residues"
         + (f"; skipped {len(skipped)} (listed in {folder / 'skipped.csv'})" if skipped else ""),
         f"wrote {', '.join(str(folder / name) for name in OUTPUTS)}",
     ]
     if not rows:
         return "\n".join(lines)
     stat = {(r.ribbon, r.mode, r.depth, r.ss_class): r for r in rows}
-    lines += ["", "pooled rms |Cα − C^r| in Å (SD of the distances); depth = decomposition step below the full curve",
-              f"{'':<18}{'peptide-plane ribbon':^44}{'Cα ribbon':>12}",
-              f"{'mode':<11}{'depth':>5}  {'all':>13}{'helix':>8}{'sheet':>8}{'other':>8}{'n':>8}{'all':>12}"]
+
+    def rms(ribbon: str, mode: str, depth: float, name: str = "all", width: int = 8) -> str:
+        row = stat.get((ribbon, mode, float(depth), name))
+        return f"{row.rms:{width}.2f}" if row else f"{'–':>{width}}"
+
+    lines += ["", "pooled rms |Cα − C^r| in Å (SD of the distances) by decomposition step (depth)",
+              f"{'':<17}{'peptide-plane ribbon':^45}{'Cα ribbon':>11}",
+              f"{'mode':<11}{'depth':>6}{'all (SD)':>14}{'helix':>8}{'sheet':>8}{'other':>8}{'residues':>10}{'all':>8}"]
     for mode in MODES:
         for depth in sorted({r.depth for r in rows if r.mode == mode}):
-            row = [stat.get(("peptide", mode, depth, name)) for name in CLASSES]
-            alpha = stat.get(("calpha", mode, depth, "all"))
-            first = f"{row[0].rms:6.2f} ({row[0].sd:4.2f})" if row[0] else f"{'–':>13}"
-            lines.append(f"{mode:<11}{depth:>5g}  {first:>13}" + "".join(f"{r.rms:8.2f}" if r else f"{'–':>8}" for r in row[1:])
-                         + f"{row[0].n_residues if row[0] else 0:>8}" + (f"{alpha.rms:12.2f}" if alpha else f"{'–':>12}"))
-    lines += ["", f"{'':<40}{'peptide':>9}{'Cα':>8}   Carson 1996"]
+            every = stat.get(("peptide", mode, depth, "all"))
+            first = f"{every.rms:.2f} ({every.sd:.2f})" if every else "–"
+            lines.append(f"{mode:<11}{depth:>6g}{first:>14}" + "".join(rms("peptide", mode, depth, c) for c in CLASSES[1:])
+                         + f"{every.n_residues if every else 0:>10}" + rms("calpha", mode, depth))
+    lines += ["", f"{'':<42}{'peptide':>8}{'Cα':>8}   Carson 1996 (230 proteins)"]
     for depth, paper in PAPER.items():
-        values = "".join(f"{stat[(k, 'integer', float(depth), 'all')].rms:>7.2f} Å" if (k, "integer", float(depth), "all") in stat
-                         else f"{'–':>9}" for k in ("peptide", "calpha"))
-        lines.append(f"{f'rms at 1/{2**depth} of the segments (depth {depth})':<40}{values}   {paper} Å")
-    crossings = [rms_crossing(rows, CA_CA, ribbon) for ribbon in ("peptide", "calpha")]
-    text = "".join(f"{c:>9.2f}" if c is not None else f"{'never':>9}" for c in crossings)
-    lines.append(f"{f'fractional depth where rms passes {CA_CA} Å':<40}{text}   between 2.0 and 3.0"
-                 " (linear between the depths computed)")
+        lines.append(f"{f'rms at 1/{2**depth} of the segments (depth {depth}), Å':<42}"
+                     f"{rms('peptide', 'integer', depth)}{rms('calpha', 'integer', depth)}   {paper}")
+    crossings = "".join(f"{c:8.2f}" if c is not None else f"{'never':>8}"
+                        for c in (rms_crossing(rows, CA_CA, ribbon) for ribbon in ("peptide", "calpha")))
+    lines.append(f"{f'fractional depth where the rms passes {CA_CA} Å':<42}{crossings}   between 2.0 and 3.0")
+    lines.append("(the crossing is interpolated linearly between the fractional depths computed)")
     return "\n".join(lines)
 
 

@@ -2,6 +2,7 @@
 
 import csv
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -61,7 +62,9 @@ def test_analyze_writes_the_tables_and_reports_skipped_files(database, tmp_path,
     expected = sum(read_structure(DATA / name).n_residues for name in ENTRIES)
     assert len(residues) == expected
     assert f"analysed {len(ENTRIES)} file(s)" in out and f"{expected} residues" in out
-    assert "2.1 Å" in out and "3.3 Å" in out and "passes 3.8 Å" in out
+    assert re.search(r"rms at 1/4 of the segments \(depth 2\), Å +\d\.\d\d +\d\.\d\d +2\.1\n", out)
+    assert re.search(r"rms at 1/8 of the segments \(depth 3\), Å +\d\.\d\d +\d\.\d\d +3\.3\n", out)
+    assert re.search(r"depth where the rms passes 3\.8 Å +[23]\.\d\d +[23]\.\d\d ", out)
 
 
 def test_summary_has_exactly_the_contract_columns_and_agrees_with_the_residue_rows(analysed):
