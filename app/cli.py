@@ -14,7 +14,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
-from app import DEFAULT_STRUCTURE, analysis_commands, structure_commands
+from app import DEFAULT_STRUCTURE, analysis_commands, structure_commands, surface_commands
 
 PROG = "ribbonwave"
 DEFAULT_COMMAND = "open"
@@ -106,6 +106,8 @@ COMMANDS: dict[str, Command] = {
                        analysis_commands.analyze_arguments, analysis_commands.run_analyze),
     "compare": Command("superpose two chains and judge fits on fewer Cα or on low-resolution curves",
                        analysis_commands.compare_arguments, analysis_commands.run_compare),
+    "surface": Command("molecular surface, globe, DNA cylinder, remeshing or density map at a level, to .vtp/.ply/.png",
+                       surface_commands.surface_arguments, surface_commands.run_surface),
 }
 
 
