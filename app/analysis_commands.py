@@ -34,13 +34,13 @@ from core.analysis import (
     ChainSelection,
     FileAnalysis,
     Gaps,
+    PooledStatistics,
     SkippedFile,
     SSPolicy,
     SummaryRow,
     Termini,
     analyse_path,
     rms_crossing,
-    summarize,
 )
 from core.compare import Comparison, compare_chains
 from core.ribbon import RibbonKind
@@ -56,6 +56,8 @@ PAPER = {2: 2.1, 3: 3.3}
 """Carson's pooled rms (Å) of the peptide-plane ribbon at integer depths 2 and 3."""
 CLASS_COLOURS = {"all": "black", "helix": "tab:red", "sheet": "tab:blue", "other": "tab:gray"}
 RIBBON_TITLES = {"peptide": "peptide-plane ribbon", "calpha": "Cα ribbon"}
+Outcome = tuple[FileAnalysis | SkippedFile, str]
+"""A file's analysis (or why it was skipped) and its ``residues.csv`` rows."""
 
 
 # --------------------------------------------------------------------------- analyze
@@ -95,23 +97,29 @@ def run_analyze(args: argparse.Namespace) -> int:
         raise InputError(str(error)) from None
     paths = structure_paths(args.paths)
     _prepare_output(args.output, args.overwrite)
-    results: list[FileAnalysis | SkippedFile | None] = [None] * len(paths)
-    progress = _progress(len(paths))
-    with progress:
-        for index, result in _run(paths, options, args.jobs, args.scheduler):
-            results[index] = result
+    pooled, skipped = PooledStatistics(options), []
+    waiting: dict[int, Outcome] = {}  # finished out of order
+    with (_atomic_path(args.output / "residues.csv") as table_path, table_path.open("w", encoding="utf-8") as table,
+          tqdm(total=len(paths), unit="file", desc="analysing", file=sys.stderr, mininterval=0.5) as progress):
+        table.write(",".join(RESIDUE_COLUMNS + tuple(c.name for c in options.columns)) + "\n")
+        for index, (result, lines) in _run(paths, options, args.jobs, args.scheduler):
+            progress.update()
             if isinstance(result, SkippedFile):
                 progress.write(f"skipped {result.path}: {result.reason}", file=sys.stderr)
-            progress.update()
-    analyses = [r for r in results if isinstance(r, FileAnalysis)]
-    skipped = [r for r in results if isinstance(r, SkippedFile)]
-    rows = summarize(analyses, options)
-    _atomic_text(args.output / "residues.csv", residues_csv(analyses, options))
+            waiting[index] = result, lines
+            while (pooled.n_files + len(skipped)) in waiting:  # keep the files in input order
+                ready, lines = waiting.pop(pooled.n_files + len(skipped))
+                if isinstance(ready, SkippedFile):
+                    skipped.append(ready)
+                else:
+                    pooled.add(ready)
+                    table.write(lines)
+    rows = pooled.rows()
     _atomic_text(args.output / "summary.csv", summary_csv(rows))
     _atomic_text(args.output / "skipped.csv", _csv_text([("file", "reason")] + [(str(s.path), s.reason) for s in skipped]))
     with _atomic_path(args.output / "fig7.png") as png:
         plot_fig7(rows, png)
-    print(summary_text(rows, analyses, skipped, args.output))
+    print(summary_text(pooled, skipped, args.output))
     return 0
 
 
@@ -133,28 +141,29 @@ def structure_paths(paths: list[Path]) -> list[Path]:
 
 
 def _run(paths: list[Path], options: AnalysisOptions, jobs: int, scheduler: str | None
-         ) -> Iterator[tuple[int, FileAnalysis | SkippedFile]]:
+         ) -> Iterator[tuple[int, Outcome]]:
     """(index, result) of every path, in order of completion."""
     if scheduler is not None:
         yield from _run_dask(paths, options, jobs, scheduler)
     elif jobs == 1 or len(paths) == 1:
         for index, path in enumerate(paths):
-            yield index, analyse_path(path, options)
+            yield index, analyse_file(path, options)
     else:
         context = multiprocessing.get_context("forkserver")  # no fork of a threaded parent
-        context.set_forkserver_preload(["core.analysis"])
+        context.set_forkserver_preload(["app.analysis_commands"])
         with ProcessPoolExecutor(min(jobs, len(paths)), mp_context=context) as pool:
-            futures = {pool.submit(analyse_path, path, options): index for index, path in enumerate(paths)}
+            futures = {pool.submit(analyse_file, path, options): index for index, path in enumerate(paths)}
             try:
                 for future in as_completed(futures):
-                    yield futures[future], _result(future, paths[futures[future]])
+                    index = futures.pop(future)  # hold no finished result longer than needed
+                    yield index, _outcome(future, paths[index])
             except BaseException:  # Ctrl+C or an error: drop the files not started yet
                 pool.shutdown(cancel_futures=True)
                 raise
 
 
 def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: str
-              ) -> Iterator[tuple[int, FileAnalysis | SkippedFile]]:
+              ) -> Iterator[tuple[int, Outcome]]:
     try:
         from dask.distributed import Client, LocalCluster, as_completed as dask_completed
     except ImportError:
@@ -167,22 +176,27 @@ def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: s
             client = stack.enter_context(Client(scheduler, timeout=10))
         except (OSError, ValueError) as error:
             raise InputError(f"cannot reach the Dask scheduler {address}: {error}") from None
-        futures = client.map(analyse_path, paths, options=options, pure=False)
+        futures = client.map(analyse_file, paths, options=options, pure=False)
         index = {future.key: k for k, future in enumerate(futures)}
-        for future in dask_completed(futures):
-            yield index[future.key], _result(future, paths[index[future.key]])
+        completed = dask_completed(futures)
+        del futures  # a result is released on the cluster once it has been handled
+        for future in completed:
+            k = index.pop(future.key)
+            yield k, _outcome(future, paths[k])
 
 
-def _result(future, path: Path) -> FileAnalysis | SkippedFile:
-    """A finished job's result; a worker that died gives a skipped file, not a failed run."""
+def analyse_file(path: Path, options: AnalysisOptions) -> Outcome:
+    """The task run by a worker: the rows are formatted there too, in parallel."""
+    result = analyse_path(path, options)
+    return result, residue_lines(result) if isinstance(result, FileAnalysis) else ""
+
+
+def _outcome(future, path: Path) -> Outcome:
+    """A finished task's outcome; a worker that died gives a skipped file, not a failed run."""
     try:
         return future.result()
     except Exception as error:  # noqa: BLE001 - e.g. a worker killed while reading this file
-        return SkippedFile(path, f"worker failed ({type(error).__name__}: {error})")
-
-
-def _progress(total: int) -> tqdm:
-    return tqdm(total=total, unit="file", desc="analysing", file=sys.stderr, mininterval=0.5)
+        return SkippedFile(path, f"worker failed ({type(error).__name__}: {error})"), ""
 
 
 def _prepare_output(folder: Path, overwrite: bool) -> None:
@@ -197,20 +211,19 @@ def _prepare_output(folder: Path, overwrite: bool) -> None:
         raise InputError(f"{folder}: cannot create the folder ({error.strerror})") from None
 
 
-def residues_csv(analyses: list[FileAnalysis], options: AnalysisOptions) -> str:
-    """Per-residue rows: the residue, its class and ``|Cα − C^r|`` (Å) in every depth column."""
-    columns = options.columns
-    lines = [",".join(RESIDUE_COLUMNS + tuple(c.name for c in columns))]
-    number = ",".join(["%.3f"] * len(columns))
-    for a in analyses:
-        head = f"{_field(str(a.path))},{_field(a.entry)}"
+def residue_lines(analysis: FileAnalysis) -> str:
+    """The ``residues.csv`` rows of one file: the residue, its class and ``|Cα − C^r|`` (Å, 3
+    decimals, empty beyond a curve's lowest level) in every depth column."""
+    head = f"{_field(str(analysis.path))},{_field(analysis.entry)}"
+    number = ",".join(["%.3f"] * analysis.deviations.shape[1])
+    return "".join(
+        f"{head},{_field(chain)},{curve},{resseq},{_field(icode)},{_field(resname)},{ss},{ss_class},"
+        + (number % tuple(values)).replace("nan", "") + "\n"
         for values, chain, curve, resseq, icode, resname, ss, ss_class in zip(
-            a.deviations.tolist(), a.chain.tolist(), a.curve.tolist(), a.resseq.tolist(), a.icode.tolist(),
-            a.resname.tolist(), a.ss.tolist(), a.ss_class.tolist(),
-        ):
-            lines.append(f"{head},{_field(chain)},{curve},{resseq},{_field(icode)},{_field(resname)},{ss},{ss_class},"
-                         + (number % tuple(values)).replace("nan", ""))
-    return "\n".join(lines) + "\n"
+            analysis.deviations.tolist(), analysis.chain.tolist(), analysis.curve.tolist(), analysis.resseq.tolist(),
+            analysis.icode.tolist(), analysis.resname.tolist(), analysis.ss.tolist(), analysis.ss_class.tolist(),
+        )
+    )
 
 
 def summary_csv(rows: list[SummaryRow]) -> str:
@@ -220,11 +233,11 @@ def summary_csv(rows: list[SummaryRow]) -> str:
     ])
 
 
-def summary_text(rows: list[SummaryRow], analyses: list[FileAnalysis], skipped: list[SkippedFile], folder: Path) -> str:
+def summary_text(pooled: PooledStatistics, skipped: list[SkippedFile], folder: Path) -> str:
     """The report printed at the end of ``analyze``."""
+    rows = pooled.rows()
     lines = [
-        f"analysed {len(analyses)} file(s), {sum(a.n_curves for a in analyses)} curves, "
-        f"{sum(len(a) for a in analyses)} residues"
+        f"analysed {pooled.n_files} file(s), {pooled.n_curves} curves, {pooled.n_residues} residues"
         + (f"; skipped {len(skipped)} (listed in {folder / 'skipped.csv'})" if skipped else ""),
         f"wrote {', '.join(str(folder / name) for name in OUTPUTS)}",
     ]

@@ -244,25 +244,63 @@ def analyse_path(path: Path, options: AnalysisOptions = AnalysisOptions()) -> Fi
         return SkippedFile(Path(path), reason)
 
 
-def summarize(analyses: list[FileAnalysis], options: AnalysisOptions = AnalysisOptions()) -> list[SummaryRow]:
-    """Pooled rms and SD of ``|Cα − C^r|`` per column and class, over all residues.
+class PooledStatistics:
+    """Running sums of ``|Cα − C^r|`` per column and class, so a database of any size is
+    summarised file by file in constant memory.
 
-    SD is the population standard deviation of the distances. Columns and classes
-    without residues are left out.
+    Attributes
+    ----------
+    options : AnalysisOptions
+    n_files, n_curves, n_residues : what has been added.
+    count, total, total_squares : (len(options.columns), len(CLASSES)) residues with a
+        value, sum of the distances (Å) and of their squares (Å²).
     """
-    if not analyses:
-        return []
-    deviations = np.vstack([a.deviations for a in analyses])
-    ss_class = np.concatenate([a.ss_class for a in analyses])
-    rows = []
-    for k, column in enumerate(options.columns):
-        values = deviations[:, k]
-        for name in CLASSES:
-            picked = values[np.isfinite(values) & ((ss_class == name) if name != "all" else True)]
-            if len(picked):
-                rms, sd = float(np.sqrt(np.mean(picked**2))), float(np.std(picked))
-                rows.append(SummaryRow(column.ribbon.value, column.mode, column.depth, name, len(picked), rms, sd))
-    return rows
+
+    def __init__(self, options: AnalysisOptions = AnalysisOptions()):
+        self.options = options
+        self.n_files = self.n_curves = self.n_residues = 0
+        shape = (len(options.columns), len(CLASSES))
+        self.count = np.zeros(shape, dtype=np.int64)
+        self.total = np.zeros(shape)
+        self.total_squares = np.zeros(shape)
+
+    def add(self, analysis: FileAnalysis) -> None:
+        """Pool the residues of one file (analysed with the same options)."""
+        if analysis.deviations.shape[1] != len(self.options.columns):
+            raise ValueError(f"{analysis.path}: analysed with other depths ({analysis.deviations.shape[1]} columns, "
+                             f"expected {len(self.options.columns)})")
+        self.n_files += 1
+        self.n_curves += analysis.n_curves
+        self.n_residues += len(analysis)
+        finite = np.isfinite(analysis.deviations)
+        values = np.where(finite, analysis.deviations, 0.0)
+        for k, name in enumerate(CLASSES):
+            rows = slice(None) if name == "all" else analysis.ss_class == name
+            self.count[:, k] += finite[rows].sum(axis=0)
+            self.total[:, k] += values[rows].sum(axis=0)
+            self.total_squares[:, k] += (values[rows] ** 2).sum(axis=0)
+
+    def rows(self) -> list[SummaryRow]:
+        """rms and SD (population SD of the distances) per column and class with residues."""
+        rows = []
+        for k, column in enumerate(self.options.columns):
+            for c, name in enumerate(CLASSES):
+                n = int(self.count[k, c])
+                if n:
+                    mean, mean_square = self.total[k, c] / n, self.total_squares[k, c] / n
+                    sd = math.sqrt(max(mean_square - mean**2, 0.0))
+                    rows.append(SummaryRow(column.ribbon.value, column.mode, column.depth, name, n,
+                                           math.sqrt(mean_square), sd))
+        return rows
+
+
+def summarize(analyses: list[FileAnalysis], options: AnalysisOptions = AnalysisOptions()) -> list[SummaryRow]:
+    """Pooled rms and SD of ``|Cα − C^r|`` per column and class over the residues of
+    ``analyses`` (see :class:`PooledStatistics`)."""
+    pooled = PooledStatistics(options)
+    for analysis in analyses:
+        pooled.add(analysis)
+    return pooled.rows()
 
 
 def rms_crossing(
