@@ -11,6 +11,7 @@ from core.analysis import (
     UNCLASSIFIED,
     AnalysisOptions,
     FileAnalysis,
+    PooledStatistics,
     SkippedFile,
     analyse_path,
     analyse_structure,
@@ -168,3 +169,14 @@ def test_files_that_cannot_be_used_are_skipped_with_a_reason(tmp_path):
     assert "no such file" in results["missing"].reason
     assert results["garbage"].reason and str(tmp_path) not in results["garbage"].reason
     assert isinstance(analyse_path(DATA / "1UBQ.pdb.gz"), FileAnalysis)
+
+
+def test_pooled_statistics_add_file_by_file(structures):
+    options = AnalysisOptions(max_depth=3)
+    pooled = PooledStatistics(options)
+    for name in ("1UBQ", "4HHB"):
+        pooled.add(analyse_structure(structures[name], options))
+    assert (pooled.n_files, pooled.n_residues) == (2, 76 + structures["4HHB"].n_residues)
+    assert pooled.n_curves == 1 + len(structures["4HHB"].segments)
+    with pytest.raises(ValueError, match="other depths"):
+        pooled.add(analyse_structure(structures["1UBQ"], AnalysisOptions(max_depth=2)))
