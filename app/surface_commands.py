@@ -156,6 +156,11 @@ def _render(polydata, scalars: np.ndarray | None, colouring: str | None, path: s
                              scalar_bar_args={"title": f"{colouring} ({UNITS[colouring]})"})
         plotter.set_background("white")
         plotter.view_isometric()
+        normal = np.asarray(polydata.compute_normals(cell_normals=True, point_normals=False).cell_data["Normals"]).mean(axis=0)
+        if np.linalg.norm(normal) > 0.5:  # a patch: look at it from outside
+            centre, size = np.asarray(polydata.center), polydata.length
+            up = np.cross(normal, [1.0, 0, 0] if abs(normal[0]) < 0.9 else [0, 1.0, 0])
+            plotter.camera_position = [tuple(centre + 2 * size * normal), tuple(centre), tuple(up)]
         plotter.screenshot(path)
     finally:
         plotter.close()
