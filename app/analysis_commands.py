@@ -240,6 +240,9 @@ def summary_text(pooled: PooledStatistics, skipped: list[SkippedFile], folder: P
         f"analysed {pooled.n_files} file(s), {pooled.n_curves} curves, {pooled.n_residues} residues"
         + (f"; skipped {len(skipped)} (listed in {folder / 'skipped.csv'})" if skipped else ""),
         f"wrote {', '.join(str(folder / name) for name in OUTPUTS)}",
+        f"{pooled.n_residues_without_records} residues in {pooled.n_files_without_records} file(s) without "
+        "HELIX/SHEET records: " + ("counted only in class 'all'" if pooled.options.ss is SSPolicy.RECORDS
+                                   else "helix/sheet/other computed by DSSP"),
     ]
     if not rows:
         return "\n".join(lines)

@@ -252,6 +252,9 @@ class PooledStatistics:
     ----------
     options : AnalysisOptions
     n_files, n_curves, n_residues : what has been added.
+    n_files_without_records, n_residues_without_records : of those, the files without
+        HELIX/SHEET records, whose classes were computed (``SSPolicy.AUTO``) or left out
+        (``SSPolicy.RECORDS``).
     count, total, total_squares : (len(options.columns), len(CLASSES)) residues with a
         value, sum of the distances (Å) and of their squares (Å²).
     """
@@ -259,6 +262,7 @@ class PooledStatistics:
     def __init__(self, options: AnalysisOptions = AnalysisOptions()):
         self.options = options
         self.n_files = self.n_curves = self.n_residues = 0
+        self.n_files_without_records = self.n_residues_without_records = 0
         shape = (len(options.columns), len(CLASSES))
         self.count = np.zeros(shape, dtype=np.int64)
         self.total = np.zeros(shape)
@@ -272,6 +276,9 @@ class PooledStatistics:
         self.n_files += 1
         self.n_curves += analysis.n_curves
         self.n_residues += len(analysis)
+        if analysis.ss_source == SS_COMPUTED:
+            self.n_files_without_records += 1
+            self.n_residues_without_records += len(analysis)
         finite = np.isfinite(analysis.deviations)
         values = np.where(finite, analysis.deviations, 0.0)
         for k, name in enumerate(CLASSES):

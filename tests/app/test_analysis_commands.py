@@ -62,6 +62,7 @@ def test_analyze_writes_the_tables_and_reports_skipped_files(database, tmp_path,
     expected = sum(read_structure(DATA / name).n_residues for name in ENTRIES)
     assert len(residues) == expected
     assert f"analysed {len(ENTRIES)} file(s)" in out and f"{expected} residues" in out
+    assert "67 residues in 1 file(s) without HELIX/SHEET records: helix/sheet/other computed by DSSP" in out
     assert re.search(r"rms at 1/4 of the segments \(depth 2\), Å +\d\.\d\d +\d\.\d\d +2\.1\n", out)
     assert re.search(r"rms at 1/8 of the segments \(depth 3\), Å +\d\.\d\d +\d\.\d\d +3\.3\n", out)
     assert re.search(r"depth where the rms passes 3\.8 Å +[23]\.\d\d +[23]\.\d\d ", out)
@@ -117,6 +118,7 @@ def test_reference_selection_options(tmp_path, capsys):
             "--gaps", "join", "--termini", "calpha", "--ss", "records"]
     status, out, _ = run(capsys, *args, "-o", tmp_path / "reference")
     assert status == 0 and "2 curves, 213 residues" in out  # 4HHB chain D (146, in three pieces) + 2O9S (67)
+    assert "67 residues in 1 file(s) without HELIX/SHEET records: counted only in class 'all'" in out
     residues = read_csv(tmp_path / "reference" / "residues.csv")
     assert {r["chain"] for r in residues if r["entry"] == "4HHB"} == {"D"}
     assert {r["curve"] for r in residues} == {"0"}

@@ -178,5 +178,8 @@ def test_pooled_statistics_add_file_by_file(structures):
         pooled.add(analyse_structure(structures[name], options))
     assert (pooled.n_files, pooled.n_residues) == (2, 76 + structures["4HHB"].n_residues)
     assert pooled.n_curves == 1 + len(structures["4HHB"].segments)
+    assert (pooled.n_files_without_records, pooled.n_residues_without_records) == (0, 0)
+    pooled.add(analyse_structure(structures["2O9S_A"], options))
+    assert (pooled.n_files_without_records, pooled.n_residues_without_records) == (1, 67)
     with pytest.raises(ValueError, match="other depths"):
         pooled.add(analyse_structure(structures["1UBQ"], AnalysisOptions(max_depth=2)))
