@@ -14,7 +14,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
-from app import DEFAULT_STRUCTURE, analysis_commands, structure_commands, surface_commands
+from app import DEFAULT_STRUCTURE, analysis_commands, structure_commands, surface_commands, validate_commands
 
 PROG = "ribbonwave"
 DEFAULT_COMMAND = "open"
@@ -108,6 +108,8 @@ COMMANDS: dict[str, Command] = {
                        analysis_commands.compare_arguments, analysis_commands.run_compare),
     "surface": Command("molecular surface, globe, DNA cylinder, remeshing or density map at a level, to .vtp/.ply/.png",
                        surface_commands.surface_arguments, surface_commands.run_surface),
+    "validate": Command("geometry report: peptide junctions, Ramachandran outliers, clashes",
+                        validate_commands.validate_arguments, validate_commands.run_validate),
 }
 
 

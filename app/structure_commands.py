@@ -16,8 +16,10 @@ from pathlib import Path
 import numpy as np
 
 from core.model import EditableModel
+from core.regularize import regularized
 from core.ribbon import RibbonKind, segment_ribbon
 from core.structure import BackboneSegment, Structure, StructureError, read_structure
+from core.validation import validate
 
 CURVE_COLUMNS = ("chain", "segment", "resseq", "icode", "resname", "ss",
                  "ca_x", "ca_y", "ca_z", "cr_x", "cr_y", "cr_z", "dist")
@@ -162,6 +164,8 @@ def edit_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
                         help="output file; PDB or mmCIF by the extension (.pdb, .cif, optionally .gz)")
     parser.add_argument("--overwrite", action="store_true", help="replace OUT if it exists (even the input file)")
+    parser.add_argument("--regularize", action="store_true",
+                        help="then move the residues again (rigidly) to ideal peptide junctions without new clashes")
 
 
 def run_edit(args: argparse.Namespace) -> int:
@@ -175,6 +179,8 @@ def run_edit(args: argparse.Namespace) -> int:
         else:
             residue = _residue_index(structure.segments[number], args.residue)
             edit = model.tug(number, args.level, float(ribbon.residue_u[residue]), args.move)
+        if args.regularize:
+            plain, edit = edit, regularized(model, edit)
         model.apply(edit)
         written = model.save(args.output, overwrite=args.overwrite)
     except FileExistsError as error:
@@ -185,6 +191,14 @@ def run_edit(args: argparse.Namespace) -> int:
     moved = f"{labels[edit.residues[0]]}-{labels[edit.residues[-1]]}" if len(edit.residues) else "none"
     print(f"moved {len(edit.residues)} residues ({moved}), {len(edit.rows)} atoms; "
           f"wrote {written}")
+    if args.regularize:
+        region = structure.segments[number].residue_index[edit.residues]
+        before = np.array(structure.coords)
+        before[plain.rows] = plain.new_coords  # the edit without regularization
+        flagged = [validate(structure, coords, residues=region).counts for coords in (before, model.coords)]
+        print("regularized: " + ", ".join(
+            f"{flagged[0][kind]} -> {flagged[1][kind]} {name}" for kind, name in
+            (("peptide_bond", "bad peptide bonds"), ("ca_ca", "bad Cα–Cα"), ("clash", "clashes"))))
     return 0
 
 

@@ -49,7 +49,7 @@ from .validation import (
     C_N, C_N_CA, C_N_CA_PRO, C_N_PRO, CA_C_N, CA_C_N_PRO, CA_CA_CIS, CA_CA_TRANS, distance, topology,
 )  # fmt: skip
 
-FLANK = 2
+FLANK = 3
 """Residues on each side of an edit that may move too (inside the segment)."""
 JUNCTION_SIGMA = 0.01
 """Å; the scale of junction residuals (validation tolerates 0.05 Å on the C–N bond)."""

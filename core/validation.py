@@ -513,10 +513,9 @@ def validate(structure: Structure, coords: np.ndarray | None = None, residues: o
         rama = np.union1d(region_rows, np.concatenate([top.first[junctions], top.second[junctions]]))
         rows = np.flatnonzero(np.isin(structure.atom_residue, region_rows))
         region, neighbourhood = frozenset(region_rows.tolist()), frozenset(rama.tolist())
-    junction_flags, cis = _junction_flags(top, coords, junctions)
-    rama_flags, n_rama = _ramachandran_flags(top, coords, rama)
-    clash_flags, n_atoms = _clash_flags(top, structure.atom_residue, coords, rows)
-    checked = {kind: len(junctions) for kind in KINDS[:5]} | {"ramachandran": n_rama, "clash": n_atoms}
+    junction_flags, cis, checked = _junction_flags(top, coords, junctions)
+    rama_flags, checked["ramachandran"] = _ramachandran_flags(top, coords, rama)
+    clash_flags, checked["clash"] = _clash_flags(top, structure.atom_residue, coords, rows)
     flags = tuple(sorted(junction_flags + rama_flags + clash_flags, key=lambda f: -f.severity))
     return ValidationReport(checked, flags, cis, region, neighbourhood)
 
@@ -526,7 +525,9 @@ def _xyz(coords: np.ndarray, rows: np.ndarray) -> np.ndarray:
     return np.where((rows >= 0)[..., None], coords[rows.clip(min=0)], np.nan)
 
 
-def _junction_flags(top: Topology, coords: np.ndarray, junctions: np.ndarray) -> tuple[list[Flag], tuple[int, ...]]:
+def _junction_flags(
+    top: Topology, coords: np.ndarray, junctions: np.ndarray
+) -> tuple[list[Flag], tuple[int, ...], dict[str, int]]:
     first, second = top.first[junctions], top.second[junctions]
     ca1, c1 = _xyz(coords, top.backbone[first, 1]), _xyz(coords, top.backbone[first, 2])
     n2, ca2 = _xyz(coords, top.backbone[second, 0]), _xyz(coords, top.backbone[second, 1])
@@ -547,6 +548,7 @@ def _junction_flags(top: Topology, coords: np.ndarray, junctions: np.ndarray) ->
     names = {"peptide_bond": "C–N", "ca_ca": "Cα–Cα", "angle_ca_c_n": "Cα–C–N", "angle_c_n_ca": "C–N–Cα", "omega": "ω"}
     marker = np.where(np.isnan(c1 + n2), 0.5 * (ca1 + ca2), 0.5 * (c1 + n2))
     flags = []
+    checked = {kind: int(np.isfinite(value).sum()) for kind, (value, *_) in measures.items()}
     for kind, (value, ideal, tolerance, unit) in measures.items():
         ideal = np.broadcast_to(ideal, value.shape)
         deviation = value - ideal
@@ -561,7 +563,7 @@ def _junction_flags(top: Topology, coords: np.ndarray, junctions: np.ndarray) ->
                 f"{names[kind]} {value[k]:.2f}{unit}, ideal {ideal[k]:.2f}{unit}"
                 + (" (cis)" if cis[k] and kind in ("ca_ca", "omega") else ""),
             ))
-    return flags, tuple(int(i) for i in first[cis])
+    return flags, tuple(int(i) for i in first[cis]), checked
 
 
 def phi_psi(structure: Structure, coords: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:

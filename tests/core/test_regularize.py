@@ -106,7 +106,7 @@ def test_regularized_edit_is_one_exact_undo_step(ubiquitin):
     fixed = regularized(model, edit)
     assert fixed.segment == edit.segment
     assert np.array_equal(fixed.old_points, edit.old_points) and np.array_equal(fixed.new_points, edit.new_points)
-    assert set(edit.residues) <= set(fixed.residues) and len(fixed.residues) == len(edit.residues) + 4  # 2 flanks
+    assert set(edit.residues) <= set(fixed.residues) and len(fixed.residues) == len(edit.residues) + 6  # 3 flanks
     model.apply(fixed)
     untouched = np.setdiff1d(np.arange(ubiquitin.n_atoms), fixed.rows)
     assert np.array_equal(model.coords[untouched], ubiquitin.coords[untouched])
