@@ -71,6 +71,9 @@ def _open(args: argparse.Namespace) -> int:
 
     if args.level is not None and not args.level >= 0:
         raise CommandError(f"--level must be >= 0; got {args.level:g}")
+    if sys.platform.startswith("linux") and not any(map(os.environ.get, ("DISPLAY", "WAYLAND_DISPLAY",
+                                                                         "QT_QPA_PLATFORM"))):
+        raise CommandError("no display to open a window on; run under xvfb-run (scripts/ribbonwave.sh does)")
     app = QApplication.instance() or QApplication(sys.argv[:1])
     document = Document()
     try:

@@ -4,8 +4,8 @@ The full-resolution tube has ``rings_per_residue`` rings per residue: residue ``
 the parameters ``residue_u[i] ± 1/2**(J+1)`` (its peptide-ribbon segment, or the two half
 segments around its Cα), so an edit that moves some residues moves exactly their rings.
 The thin curve of a slider level is sampled at every other ring parameter. Design
-matrices of each integer level are cached, so moving the slider costs one fractional
-control polygon and two sparse products per segment.
+matrices of each integer level and the smoothed control points of the current ribbon are
+cached, so moving the slider costs three sparse products per segment.
 """
 
 from __future__ import annotations
@@ -15,8 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
+from core.filters import level_filters
 from core.ribbon import Ribbon
 from core.splines import spline_space
+from core.wavelets import smooth, split_level
 
 RINGS_PER_RESIDUE = 6
 """Tube rings per residue (the thin level curve has half as many samples)."""
@@ -72,6 +74,8 @@ class SegmentPath:
         """(R // 2 + 1,) parameters of the level-curve samples."""
         self.span = (float(self.u[0]), float(self.u[-1]))
         self._matrices: dict[int, tuple[sparse.csr_array, sparse.csr_array]] = {}
+        self._pyramid_of: Ribbon | None = None
+        self._pyramid: dict[int, np.ndarray] = {}
 
     @property
     def n_rings(self) -> int:
@@ -80,7 +84,9 @@ class SegmentPath:
     def rings(self, residues: np.ndarray) -> np.ndarray:
         """Sorted indices of the rings of ``residues`` (each residue's span, both ends included)."""
         k = self.rings_per_residue
-        return np.unique((np.asarray(residues)[:, None] * k + np.arange(k + 1)).ravel())
+        ring = np.zeros(self.n_rings, dtype=bool)
+        ring[(np.asarray(residues)[:, None] * k + np.arange(k + 1)).ravel()] = True
+        return np.flatnonzero(ring)
 
     def centres(self, points: np.ndarray, rings: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
         """Curve points (r, 3) and unit tangents (r, 3) of the finest curve at ``rings``."""
@@ -90,10 +96,30 @@ class SegmentPath:
         return space.evaluate(points, u), derivative / np.linalg.norm(derivative, axis=1, keepdims=True)
 
     def level_curve(self, ribbon: Ribbon, level: float) -> LevelCurve:
-        """The curve of ``ribbon`` at slider ``level`` sampled for display."""
-        points, j = ribbon.control_points(level)
+        """The curve of ``ribbon`` at slider ``level`` sampled for display.
+
+        Its control points equal ``ribbon.control_points(level)`` bit for bit; they are
+        blended from this ribbon's smoothed control points of every integer level, which
+        are kept until the ribbon changes.
+        """
+        j, t = split_level(ribbon.fs_level(level), ribbon.level)
+        if t == 0.0:
+            points = self._smoothed(ribbon, j)
+        else:
+            lower = level_filters(j + 1).P @ self._smoothed(ribbon, j)
+            points, j = (1.0 - t) * lower + t * self._smoothed(ribbon, j + 1), j + 1
         curve_matrix, residue_matrix = self._level_matrices(j)
         return LevelCurve(points, j, curve_matrix @ points, residue_matrix @ points, self._visible(j))
+
+    def _smoothed(self, ribbon: Ribbon, level: int) -> np.ndarray:
+        """``ribbon``'s control points smoothed to integer ``level`` (cached per ribbon)."""
+        if self._pyramid_of is not ribbon:
+            self._pyramid_of = ribbon
+            self._pyramid = {ribbon.level: ribbon.points}
+        finer = min(j for j in self._pyramid if j >= level)
+        for j in range(finer, level, -1):
+            self._pyramid[j - 1] = smooth(self._pyramid[j], j - 1)
+        return self._pyramid[level]
 
     def _level_matrices(self, level: int) -> tuple[sparse.csr_array, sparse.csr_array]:
         if level not in self._matrices:

@@ -80,6 +80,7 @@ class Document(QObject):
         self.pick: Pick | None = None
         self._curves: dict[int, LevelCurve] = {}
         self._preview: Edit | None = None
+        self._labels: list[tuple[str, ...]] = []
 
     # ------------------------------------------------------------------ state
 
@@ -121,17 +122,21 @@ class Document(QObject):
         offset = self.level_curve(segment).residue_points - ca
         return float(np.sqrt(np.mean(np.einsum("ij,ij->i", offset, offset))))
 
+    def labels(self, segment: int | None = None) -> tuple[str, ...]:
+        """Residue labels of ``segment`` (default: the current one), e.g. ``'A:LYS48'``."""
+        return self._labels[self.segment if segment is None else segment]
+
     def segment_label(self, segment: int) -> str:
         """E.g. ``'A  MET1–GLY76 (76 residues)'``."""
-        s = self.structure.segments[segment]
-        labels = s.labels
-        return f"{s.chain}  {labels[0].split(':')[1]}–{labels[-1].split(':')[1]} ({len(s)} residues)"
+        labels = self._labels[segment]
+        chain = self.structure.segments[segment].chain
+        return f"{chain}  {labels[0].split(':')[1]}–{labels[-1].split(':')[1]} ({len(labels)} residues)"
 
     def residue_range(self, residues: np.ndarray, segment: int | None = None) -> str:
         """E.g. ``'A:LYS6–A:THR9'`` (or ``'none'``)."""
         if len(residues) == 0:
             return "none"
-        labels = self.structure.segments[self.segment if segment is None else segment].labels
+        labels = self.labels(segment)
         first, last = labels[int(residues[0])], labels[int(residues[-1])]
         return first if first == last else f"{first}–{last}"
 
@@ -236,6 +241,7 @@ class Document(QObject):
         self.model = model
         self.paths = [SegmentPath(ribbon) for ribbon in model.ribbons]
         self.ca_rows = ca_rows(model.structure)
+        self._labels = [segment.labels for segment in model.structure.segments]
         self.segment = 0
         self.level = float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
         self.pick = None
@@ -252,9 +258,10 @@ class Document(QObject):
         self._preview = edit
         if previous is None:
             self._edited(Change(edit.segment, edit.residues, edit.rows))
-        else:
-            self._edited(Change(edit.segment, np.union1d(previous.residues, edit.residues),
-                                np.union1d(previous.rows, edit.rows)))
+        else:  # what the last preview moved must be redrawn too
+            n_residues, n_atoms = len(self.paths[edit.segment].residue_u), len(self._model.coords)
+            self._edited(Change(edit.segment, _union(previous.residues, edit.residues, n_residues),
+                                _union(previous.rows, edit.rows, n_atoms)))
 
     def _edited(self, change: Change) -> None:
         self._curves.pop(change.segment, None)
@@ -270,3 +277,11 @@ class Document(QObject):
             return
         self.pick = pick
         self.picked.emit()
+
+
+def _union(a: np.ndarray, b: np.ndarray, size: int) -> np.ndarray:
+    """Sorted union of two index arrays into ``range(size)`` (a mask beats hashing here)."""
+    mask = np.zeros(size, dtype=bool)
+    mask[a] = True
+    mask[b] = True
+    return np.flatnonzero(mask)

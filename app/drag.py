@@ -135,7 +135,7 @@ class DragController:
         u = float(np.clip(u, *path.span))
         point = spline_space(curve.level).evaluate(curve.control_points, u)
         residue = int(np.argmin(np.abs(path.residue_u - u)))
-        label = self.document.structure.segments[self.document.segment].labels[residue]
+        label = self.document.labels()[residue]
         return _Grab(event.on_plane(point, event.view), event.view, None, u, f"Tug curve at {label}")
 
 

@@ -12,6 +12,8 @@ turned by the smallest rotation that takes the stored tangent onto the new tange
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 
@@ -65,11 +67,26 @@ def ring_vertices(
     -------
     points, vertex_normals : (r * n_sides, 3), ring by ring.
     """
-    angle = 2.0 * np.pi * np.arange(n_sides) / n_sides
-    binormals = np.cross(tangents, normals)
-    radial = normals[:, None, :] * np.cos(angle)[None, :, None] + binormals[:, None, :] * np.sin(angle)[None, :, None]
-    points = centres[:, None, :] + radii[:, None, None] * radial
+    frames = np.concatenate([normals, np.cross(tangents, normals)], axis=1)  # (r, 6): normal, binormal
+    circle, placed = _ring_matrices(n_sides)
+    radial = np.einsum("rk,kc->rc", frames, circle)  # einsum: no BLAS threads for these thin products
+    points = np.einsum("rk,kc->rc", np.concatenate([frames * radii[:, None], centres], axis=1), placed)
     return points.reshape(-1, 3), radial.reshape(-1, 3)
+
+
+@lru_cache(maxsize=8)
+def _ring_matrices(n_sides: int) -> tuple[np.ndarray, np.ndarray]:
+    """Matrices taking a ring's (normal, binormal) (6,) to its radial unit vectors (3 n_sides,),
+    and (radius normal, radius binormal, centre) (9,) to its vertices: one matrix product per
+    ring set (much faster than broadcasting over the short xyz axis). Each ring's result depends
+    only on that ring, bit for bit, however many rings are swept together."""
+    angle = 2.0 * np.pi * np.arange(n_sides) / n_sides
+    circle = np.zeros((6, n_sides, 3))
+    for axis in range(3):
+        circle[axis, :, axis] = np.cos(angle)
+        circle[3 + axis, :, axis] = np.sin(angle)
+    circle = circle.reshape(6, -1)
+    return circle, np.vstack([circle, np.tile(np.eye(3), n_sides)])
 
 
 def tube_faces(n_rings: int, n_sides: int, first: int = 0) -> np.ndarray:

@@ -234,7 +234,34 @@ def test_dragging_a_control_point_edits_the_structure(
     assert document.save_path == target and not window.isWindowModified()
 
 
-def test_undoing_the_tube_is_exact(window: MainWindow) -> None:
+def test_the_view_drawn_in_place_is_the_view_built_afresh(window: MainWindow) -> None:
+    plotter = window.plotter
+    before = plotter.screenshot(return_img=True).astype(int)
+    _drag_control_point(window, 5, (90, 60))
+    in_place = plotter.screenshot(return_img=True).astype(int)
+    camera = plotter.camera_position
+    window.scene._build()  # every mesh made again from the document
+    plotter.camera_position = camera
+    plotter.render()
+    afresh = plotter.screenshot(return_img=True).astype(int)
+    changed = np.count_nonzero(np.abs(in_place - before).sum(axis=2) > 30)
+    different = np.count_nonzero(np.abs(in_place - afresh).sum(axis=2) > 30)
+    assert changed > 5000  # the drag is on screen ...
+    assert different < 0.1 * changed  # ... as it would be drawn from scratch (tube facets may turn a little)
+
+
+def test_switching_to_the_ca_ribbon(window: MainWindow) -> None:
+    panel, document = window.dimension_panel, window.document
+    panel.kind.setCurrentIndex(panel.kind.findData("calpha"))
+    assert document.kind == "calpha" and document.model.ribbons[0].n_curve_segments == 77
+    np.testing.assert_allclose(window.scene.meshes["curve"].points, document.level_curve().samples, atol=1e-4)
+    _drag_control_point(window, 4)
+    assert not panel.kind.isEnabled()  # the kind cannot change under an edit
+    window.undo_action.trigger()
+    assert panel.kind.isEnabled()
+
+
+def test_undo_puts_the_tube_back_exactly(window: MainWindow) -> None:
     tube = np.array(window.scene.meshes["tube"].points)
     _drag_control_point(window, 4)
     assert not np.array_equal(window.scene.meshes["tube"].points, tube)
@@ -372,6 +399,15 @@ def test_bad_level_and_unwritable_screenshot_are_one_line_errors(
     shot = tmp_path / "no-such-folder" / "shot.png"
     assert main(["--screenshot", str(shot)]) == 1
     assert capsys.readouterr().err == f"ribbonwave: error: cannot write {shot}\n"
+
+
+def test_no_display_is_a_one_line_error(
+    qapp: QApplication, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    for name in ("DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM"):
+        monkeypatch.delenv(name, raising=False)
+    assert main([str(DATA / "1UBQ.pdb.gz")]) == 1
+    assert capsys.readouterr().err.startswith("ribbonwave: error: no display to open a window on")
 
 
 def test_help_lists_the_commands(capsys: pytest.CaptureFixture[str]) -> None:
