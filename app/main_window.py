@@ -41,7 +41,7 @@ from app.document import Document
 from app.drag import DragController, Mode, PointerEvent
 from app.panels import DisplayPanel, RibbonDimensionPanel
 from app.picking import PRIORITY, PointerAdapter
-from app.scene import Scene
+from app.scene import Layer, Scene
 from core.structure import StructureError
 
 APP_NAME = "ribbonwave"
@@ -122,9 +122,13 @@ class MainWindow(QMainWindow):
         if not name:
             return False
         path = Path(name)
-        if not path.name.lower().endswith(SAVE_SUFFIXES):
+        if not path.name.lower().endswith(SAVE_SUFFIXES):  # the dialog asked about the name without it
             path = path.with_name(path.name + SAVE_FILTERS.get(chosen, suffix))
-        return self._write(path)  # the dialog has asked before replacing a file
+            replace = QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No
+            if path.exists() and QMessageBox.question(self, APP_NAME, f"{path.name} exists. Replace it?",
+                                                      replace) != QMessageBox.StandardButton.Yes:
+                return False
+        return self._write(path)
 
     def export_image(self, path: Path | None = None) -> bool:
         """Save the 3D view as a PNG image (asks for the name when ``path`` is None)."""
@@ -138,6 +142,11 @@ class MainWindow(QMainWindow):
             QMessageBox.critical(self, APP_NAME, f"cannot write {path}")
             return False
         return True
+
+    def recent_files(self) -> list[str]:
+        """Files opened or saved lately, newest first (absolute paths)."""
+        value = self.settings.value(RECENT_KEY, [])
+        return [value] if isinstance(value, str) else list(value or [])
 
     def maybe_save(self) -> bool:
         """True when it is fine to drop the document: no unsaved edits, saved, or discarded."""
@@ -280,6 +289,9 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------ slots
 
     def _on_pointer(self, event: PointerEvent) -> bool:
+        grabs = Layer.CONTROL_POINTS if self.controller.mode is Mode.POINT else Layer.CURVE
+        if event.kind == "press" and grabs not in self.scene.layers:
+            return False  # what is hidden cannot be grabbed: the press turns the camera
         return self.controller.handle(event)
 
     def _cancel(self) -> None:
@@ -307,18 +319,14 @@ class MainWindow(QMainWindow):
         self._add_recent(path)
         return True
 
-    def _recent_files(self) -> list[str]:
-        value = self.settings.value(RECENT_KEY, [])
-        return [value] if isinstance(value, str) else list(value or [])
-
     def _add_recent(self, path: Path) -> None:
         name = str(path.resolve())
-        files = [name] + [f for f in self._recent_files() if f != name]
+        files = [name] + [f for f in self.recent_files() if f != name]
         self.settings.setValue(RECENT_KEY, files[:MAX_RECENT])
 
     def _fill_recent_menu(self) -> None:
         self.recent_menu.clear()
-        for name in self._recent_files():
+        for name in self.recent_files():
             action = self.recent_menu.addAction(name)
             action.triggered.connect(lambda _=False, name=name: self.open_file(Path(name)))
         self.recent_menu.addSeparator()

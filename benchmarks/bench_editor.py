@@ -102,8 +102,10 @@ def main() -> None:
         print(f"{name} ({label}); edited segment of {len(document.structure.segments[segment])} residues, "
               f"{residues} residues in all, tube of {window.scene.meshes['tube'].n_points} vertices")
         top = document.max_level
-        for level in np.linspace(0.0, top, 8):  # warm the per-level caches, as a first pass of the slider does
-            document.set_level(level)
+        first_pass = Clock(window)  # the first visit of each level builds its filters and design matrices
+        for level in np.append(np.arange(0.0, top, 0.5), top):
+            first_pass.step(lambda level=level: document.set_level(level))
+        print(first_pass.row("slider, first pass over all levels"))
         slider = Clock(window)
         for level in np.linspace(1.0, top, MOVES):
             slider.step(lambda level=level: document.set_level(level))

@@ -287,6 +287,14 @@ def test_a_drag_beside_the_points_turns_the_camera(window: MainWindow) -> None:
     assert window.document.undo_stack.count() == 0 and window.document.pick is None
 
 
+def test_hidden_control_points_cannot_be_grabbed(window: MainWindow) -> None:
+    point = window.document.level_curve().control_points[int(window.scene.shown_control_points()[5])]
+    window.display_panel.layer_boxes[Layer.CONTROL_POINTS].setChecked(False)
+    camera = window.plotter.camera.position
+    _mouse_drag(window, _display(window, point), (40, 25))
+    assert window.document.undo_stack.count() == 0 and window.plotter.camera.position != camera
+
+
 def test_escape_cancels_a_drag(window: MainWindow) -> None:
     document = window.document
     original = document.model.coords.copy()
@@ -329,11 +337,11 @@ def test_opening_another_file_asks_and_bad_files_are_reported(window: MainWindow
     assert window.document.structure.entry_id == "1TIM" and window.document.undo_stack.count() == 0
     assert window.dimension_panel.segment.count() == 2
     assert window.windowTitle() == "1TIM.pdb.gz[*] — ribbonwave"
-    assert window._recent_files()[0] == str((DATA / "1TIM.pdb.gz").resolve())  # kept in the temporary settings
+    assert window.recent_files()[0] == str((DATA / "1TIM.pdb.gz").resolve())  # kept in the temporary settings
     assert window.settings.value(RECENT_KEY)
 
 
-def test_save_never_overwrites_the_input_without_asking(window: MainWindow, tmp_path: Path, monkeypatch) -> None:
+def test_save_never_overwrites_without_asking(window: MainWindow, tmp_path: Path, monkeypatch, questions) -> None:
     source = tmp_path / "input.pdb"
     source.write_bytes((DATA / "1UBQ.pdb.gz").read_bytes())
     assert window.open_file(source)
@@ -341,9 +349,18 @@ def test_save_never_overwrites_the_input_without_asking(window: MainWindow, tmp_
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *args, **kwargs: ("", ""))  # cancelled
     assert not window.save()
     assert source.read_bytes() == (DATA / "1UBQ.pdb.gz").read_bytes()
-    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *args, **kwargs: (str(tmp_path / "out"), "mmCIF (*.cif *.cif.gz *.mmcif)"))
+    mmcif = "mmCIF (*.cif *.cif.gz *.mmcif)"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *args, **kwargs: (str(tmp_path / "out"), mmcif))
     assert window.save()
     assert (tmp_path / "out.cif").exists() and window.document.save_path == tmp_path / "out.cif"
+    (tmp_path / "out.cif").write_text("an older file")
+    window.document.save_path = None  # as after opening a file: Save asks for a name again
+    questions.answer = questions.answer.No
+    assert not window.save()  # "out" + ".cif" exists: asked, and the answer was no
+    assert questions.asked[-1] == "out.cif exists. Replace it?"
+    assert (tmp_path / "out.cif").read_text() == "an older file"
+    questions.answer = questions.answer.Yes
+    assert window.save()
     _drag_control_point(window, 5)
     assert window.save()  # later saves go to the chosen file without asking
     np.testing.assert_allclose(read_structure(tmp_path / "out.cif").coords, window.document.model.coords, atol=6e-4)
