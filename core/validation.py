@@ -14,9 +14,10 @@ programs; σ their standard deviations):
 - every **pair of heavy atoms** closer than their contact distance by more than 0.4 Å
   (MolProbity's clash criterion), found with a k-d tree. Contact distances are sums of
   van der Waals radii (:data:`VDW_RADIUS`), 2.8 Å for N/O pairs (which may hydrogen-bond).
-  Pairs at most three bonds apart never clash; the bonds are those of the structure as
-  read (covalent radii + 0.45 Å) plus the peptide bonds of the segments, so an edit that
-  stretches a bond does not turn it into a clash. Atoms of different alternate conformers
+  Pairs at most three bonds apart never clash; the bonds are those within each residue
+  of the structure as read (covalent radii + 0.45 Å), the peptide bonds of the segments,
+  disulfides and links to non-protein groups, so an edit that stretches a bond does not
+  turn it into a clash. Atoms of different alternate conformers
   never clash; hydrogens, waters (an edit makes the solvent model stale anyway) and
   elements without a radius (metals) are not checked.
 
@@ -358,14 +359,32 @@ def _atom_labels(structure: Structure, residue_labels: np.ndarray) -> np.ndarray
 def _excluded_pairs(
     structure: Structure, backbone: np.ndarray, first: np.ndarray, second: np.ndarray, checked: np.ndarray
 ) -> np.ndarray:
-    """Sorted keys of the checked atom pairs at most three bonds apart in the input."""
+    """Sorted keys of the checked atom pairs at most three bonds apart.
+
+    Bonds: atoms of one residue within covalent reach in the input, the peptide bonds of
+    the segments, and between residues only disulfides and links that involve a
+    non-protein group (ligands, glycans, nucleic acids): two amino acids close together
+    in the file are a clash to report, not a bond.
+    """
     n_atoms = structure.n_atoms
+    table = structure.atoms
     atoms = np.flatnonzero(checked)
-    covalent = np.array([COVALENT_RADIUS.get(e, 0.0) for e in structure.atoms.element])
+    covalent = np.array([COVALENT_RADIUS.get(e, 0.0) for e in table.element])
     tree = cKDTree(structure.coords[atoms])
     pairs = tree.query_pairs(2 * max(COVALENT_RADIUS.values()) + BOND_SLACK, output_type="ndarray")
     i, j = atoms[pairs[:, 0]], atoms[pairs[:, 1]]
-    bonded = distance(structure.coords[i], structure.coords[j]) < covalent[i] + covalent[j] + BOND_SLACK
+    protein = table.category == "protein"
+    # residue groups (alternative residues sharing a number are one group)
+    group = np.where(structure.atom_residue >= 0, structure.atom_residue, structure.n_residues + table.residue)
+    peptide_names = ((table.name[i] == "C") & (table.name[j] == "N")) | ((table.name[i] == "N") & (table.name[j] == "C"))
+    linkable = (
+        (group[i] == group[j])
+        | (peptide_names & (np.abs(group[i] - group[j]) == 1))
+        | ~protein[i]
+        | ~protein[j]
+        | ((table.element[i] == "S") & (table.element[j] == "S"))
+    )
+    bonded = linkable & (distance(structure.coords[i], structure.coords[j]) < covalent[i] + covalent[j] + BOND_SLACK)
     peptide = np.stack([backbone[first, 2], backbone[second, 0]], axis=1)
     peptide = peptide[(peptide >= 0).all(axis=1)]
     i = np.concatenate([i[bonded], peptide[:, 0]])

@@ -207,3 +207,14 @@ def test_report_as_dict_and_bad_arguments(ubiquitin):
         validate(ubiquitin, np.zeros((3, 3)))
     with pytest.raises(ValueError, match="residues"):
         validate(ubiquitin, residues=[76])
+
+
+def test_a_saved_edit_validates_like_the_model(ubiquitin, tmp_path):
+    """Bonds come from residues and names, not from whatever is close in the file: the
+    clashes of an edited model read back from disk are the clashes of the model."""
+    model = EditableModel(ubiquitin)
+    model.apply(model.move_point(0, 3, 3, [5.0, 0.0, 0.0]))
+    in_memory = validate(ubiquitin, model.coords)
+    from_file = validate(read_structure(model.save(tmp_path / "bent.pdb")))
+    assert in_memory.counts["clash"] > 20
+    assert {(f.kind, f.where) for f in from_file.flags} == {(f.kind, f.where) for f in in_memory.flags}
