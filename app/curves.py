@@ -89,11 +89,21 @@ class SegmentPath:
         return np.flatnonzero(ring)
 
     def centres(self, points: np.ndarray, rings: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
-        """Curve points (r, 3) and unit tangents (r, 3) of the finest curve at ``rings``."""
+        """Curve points (r, 3) and unit tangents (r, 3) of the finest curve at ``rings``.
+
+        Where the first derivative vanishes (the curve's very ends, over the doubled
+        terminal control points) the tangent is the direction from which the curve arrives
+        there, given by the second derivative.
+        """
         space = spline_space(self.finest)
         u = self.u[rings]
         derivative = space.evaluate(points, u, 1)
-        return space.evaluate(points, u), derivative / np.linalg.norm(derivative, axis=1, keepdims=True)
+        length = np.linalg.norm(derivative, axis=1)
+        flat = length <= 1e-9 * max(float(length.max(initial=0.0)), 1.0)
+        if flat.any():
+            derivative[flat] = space.evaluate(points, u[flat], 2) * np.where(u[flat] < 0.5, 1.0, -1.0)[:, None]
+            length[flat] = np.linalg.norm(derivative[flat], axis=1)
+        return space.evaluate(points, u), derivative / length[:, None]
 
     def level_curve(self, ribbon: Ribbon, level: float) -> LevelCurve:
         """The curve of ``ribbon`` at slider ``level`` sampled for display.

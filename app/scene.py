@@ -129,9 +129,10 @@ class Scene(QObject):
         ca = self.document.model.coords[self.document.ca_rows]
         centre = ca.mean(axis=0)
         _, _, axes = np.linalg.svd(ca - centre, full_matrices=False)
-        self.plotter.camera_position = [tuple(centre + axes[2] * 100.0), tuple(centre), tuple(axes[1])]
-        self.plotter.reset_camera()
-        self.plotter.camera.zoom(1.15)
+        renderer = self.plotter.renderer
+        renderer.camera_position = [tuple(centre + axes[2] * 100.0), tuple(centre), tuple(axes[1])]
+        renderer.reset_camera(render=False)
+        renderer.camera.zoom(1.15)
 
     def shown_control_points(self) -> np.ndarray:
         """Indices (into the level curve's control points) of the spheres on screen."""
@@ -232,7 +233,7 @@ class Scene(QObject):
             ca = model.coords[self.document.ca_rows[table_rows]]
             self._move_glyphs("ca_balls", _span(table_rows), ca)
             self._write("ca_sticks", _span(table_rows), ca)
-        if len(change.rows) and "atoms" in self.meshes:
+        if len(change.rows) and self.meshes["atoms"].n_points:  # no bonds (a Cα-only model): no mesh
             rows = _span(np.sort(change.rows))
             self._write("atoms", rows, model.coords[rows])
         curve = slice(self._curve_start[segment], self._curve_start[segment + 1])
@@ -385,7 +386,7 @@ class Scene(QObject):
         if self.meshes[name].n_points == 0:  # e.g. no ions: nothing to draw
             return
         self.actors[name] = self.plotter.add_mesh(self.meshes[name], name=name, reset_camera=False, pickable=False,
-                                                  show_scalar_bar=False, smooth_shading=False, **style)
+                                                  show_scalar_bar=False, smooth_shading=False, render=False, **style)
 
     def _show_layers(self) -> None:
         for layer, names in _ACTORS.items():

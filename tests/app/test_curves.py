@@ -61,3 +61,14 @@ def test_visible_control_points_are_those_that_shape_residues(ubiquitin) -> None
     assert full.visible.sum() == len(ubiquitin) + 3  # one per peptide plane plus the terminal copies
     assert np.array_equal(np.flatnonzero(full.visible), np.arange(ribbon.front, ribbon.front + len(ubiquitin) + 3))
     assert path.level_curve(ribbon, 2.0).visible.all()  # coarse levels: every point reaches a residue
+
+
+def test_tangents_at_a_curve_end_over_doubled_control_points() -> None:
+    segment = read_structure(DATA / "1ORC.pdb.gz").segments[0]  # 64 residues: no padding, the tube starts at u = 0
+    ribbon = segment_ribbon(segment, "peptide")
+    path = SegmentPath(ribbon)
+    assert ribbon.front == 0 and path.u[0] == 0.0 and path.u[-1] == 1.0
+    centres, tangents = path.centres(ribbon.points, np.array([0, 1, path.n_rings - 2, path.n_rings - 1]))
+    np.testing.assert_allclose(np.linalg.norm(tangents, axis=1), 1.0, atol=1e-12)
+    assert tangents[0] @ tangents[1] > 0.95 and tangents[2] @ tangents[3] > 0.95  # continuous into the ends
+    assert tangents[0] @ (centres[1] - centres[0]) > 0 and tangents[3] @ (centres[3] - centres[2]) > 0
