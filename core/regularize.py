@@ -75,9 +75,13 @@ DAMPING = 1e-2
 TOLERANCE = 1e-2
 """Stop when a step is predicted to lower the objective by less than this fraction."""
 MAX_ITERATIONS = 40
-CG_STEPS = 50
+"""Levenberg–Marquardt steps at most (typically 8–20 are taken)."""
 BAND_BLOCKS = 4
+"""Width, in 6 x 6 blocks below the diagonal, of the band that preconditions the solve."""
+CG_STEPS = 50
+"""Conjugate-gradient steps at most per solve."""
 CG_TOLERANCE = 1e-12
+"""Stop the conjugate gradients when r·M⁻¹r has fallen by this factor."""
 
 
 @dataclass(frozen=True)
@@ -213,7 +217,8 @@ class _Problem:
             owners.append(owner)
             return np.arange(start, start + len(xyz))
 
-        def coincide(xyz_a, owner_a, xyz_b, owner_b, weights) -> None:  # noqa: ANN001
+        def coincide(xyz_a: np.ndarray, owner_a: np.ndarray, xyz_b: np.ndarray, owner_b: np.ndarray,
+                     weights: np.ndarray) -> None:
             weights = np.broadcast_to(weights, (len(xyz_a), 3, 3))
             vector_terms.append((add(xyz_a, owner_a), add(xyz_b, owner_b), weights))
 
