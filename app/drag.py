@@ -131,7 +131,9 @@ class DragController:
         sample = _nearest_hit(event, curve.samples, np.ones(len(curve.samples), dtype=bool), 0.0)
         if sample is None:
             return None
-        u = spline_space(curve.level).closest_parameter(curve.control_points, curve.samples[sample])
+        depth, _, _ = event.distances(curve.samples[sample][None])
+        under_pointer = event.origin + depth[0] * event.direction  # the ray's point nearest that sample
+        u = spline_space(curve.level).closest_parameter(curve.control_points, under_pointer)
         u = float(np.clip(u, *path.span))
         point = spline_space(curve.level).evaluate(curve.control_points, u)
         residue = int(np.argmin(np.abs(path.residue_u - u)))

@@ -68,6 +68,7 @@ class MainWindow(QMainWindow):
         self.plotter.iren.clear_key_event_callbacks()  # no pyvista key bindings ('q' would close the view)
         self._swallow_style_keys()
         self.plotter.enable_anti_aliasing("fxaa")
+        self._smooth_still_frames_only()
         self.setCentralWidget(self.plotter)
         self.scene = Scene(self.document, self.plotter)
         self.controller = DragController(self.document)
@@ -286,13 +287,29 @@ class MainWindow(QMainWindow):
         interactor = self.plotter.iren.interactor
         tag = interactor.AddObserver("CharEvent", lambda caller, _: caller.GetCommand(tag).SetAbortFlag(1), PRIORITY)
 
+    def _smooth_still_frames_only(self) -> None:
+        """Anti-alias the frames drawn at rest, not those drawn while the camera turns (it costs
+        half of a frame with software OpenGL); drags do the same in :meth:`_on_pointer`."""
+        style = self.plotter.iren.interactor.GetInteractorStyle()
+        style.AddObserver("StartInteractionEvent", lambda *_: self.plotter.renderer.SetUseFXAA(False))
+        style.AddObserver("EndInteractionEvent", lambda *_: self._end_interaction())
+
+    def _end_interaction(self) -> None:
+        self.plotter.renderer.SetUseFXAA(True)
+        self.plotter.render()
+
     # ------------------------------------------------------------------ slots
 
     def _on_pointer(self, event: PointerEvent) -> bool:
         grabs = Layer.CONTROL_POINTS if self.controller.mode is Mode.POINT else Layer.CURVE
         if event.kind == "press" and grabs not in self.scene.layers:
             return False  # what is hidden cannot be grabbed: the press turns the camera
-        return self.controller.handle(event)
+        if event.kind == "release" and self.controller.dragging:
+            self.plotter.renderer.SetUseFXAA(True)  # the frame after the drag is a still one
+        used = self.controller.handle(event)
+        if used and event.kind == "press":
+            self.plotter.renderer.SetUseFXAA(False)
+        return used
 
     def _cancel(self) -> None:
         if self.controller.dragging:

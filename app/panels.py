@@ -151,8 +151,10 @@ class RibbonDimensionPanel(QWidget):
     def _set_level(self, level: float) -> None:
         if self.integers.isChecked():
             level = self._integer_stop(level)
+        before = self.document.level
         self.document.set_level(level)
-        self.refresh()  # snap the widgets even when the document's level did not change
+        if self.document.level == before:
+            self.refresh()  # no signal came: snap the widgets back to the document's level
 
     def _integer_stop(self, level: float) -> float:
         """The nearest of the integer levels 0, 1, ..., ⌊log2 N⌋ and log2 N (full resolution)."""
