@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QMimeData, QPointF, Qt, QUrl
+from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
 from PySide6.QtGui import QDropEvent, QImage
 from PySide6.QtWidgets import QApplication, QFileDialog
 from pytestqt.qtbot import QtBot
@@ -259,6 +259,25 @@ def test_switching_to_the_ca_ribbon(window: MainWindow) -> None:
     assert not panel.kind.isEnabled()  # the kind cannot change under an edit
     window.undo_action.trigger()
     assert panel.kind.isEnabled()
+
+
+def test_a_drag_with_qt_mouse_events(qtbot: QtBot, window: MainWindow) -> None:
+    """The whole way from Qt: QMouseEvents on the view widget, as the window system sends them."""
+    document = window.document
+    index = int(window.scene.shown_control_points()[5])
+    start = document.level_curve().control_points[index].copy()
+    x, y = _display(window, start)
+    widget = window.plotter
+    scale = widget.devicePixelRatioF()
+    at = QPoint(round(x / scale), round(widget.height() - 1 - y / scale))  # VTK counts rows from the bottom
+    qtbot.mousePress(widget, Qt.MouseButton.LeftButton, pos=at)
+    for k in range(1, 5):
+        qtbot.mouseMove(widget, at + QPoint(10 * k, -6 * k))
+    qtbot.mouseRelease(widget, Qt.MouseButton.LeftButton, pos=at + QPoint(40, -24))
+    assert document.undo_stack.count() == 1 and document.pick.index == index
+    moved = document.level_curve().control_points[index] - start
+    assert 1.0 < np.linalg.norm(moved) < 100.0
+    np.testing.assert_allclose(moved @ np.array(window.plotter.camera.direction), 0.0, atol=1e-6)  # in the view plane
 
 
 def test_undo_puts_the_tube_back_exactly(window: MainWindow) -> None:
