@@ -72,7 +72,7 @@ SURROUNDINGS = 4.0
 """Å: the fixed atoms near the free ones are found once, for moves up to this far."""
 DAMPING = 1e-2
 """Initial Levenberg–Marquardt damping, relative to the diagonal."""
-TOLERANCE = 1e-2
+TOLERANCE = 3e-2
 """Stop when a step is predicted to lower the objective by less than this fraction."""
 MAX_ITERATIONS = 40
 """Levenberg–Marquardt steps at most (typically 8–20 are taken)."""
@@ -291,8 +291,8 @@ class _Problem:
         self.surroundings = fixed[np.all((current[fixed] >= low) & (current[fixed] <= high), axis=1)]
         self.surroundings_tree = cKDTree(current[self.surroundings])
 
-    def evaluate(self, rotation: np.ndarray, shift: np.ndarray) -> tuple[np.ndarray, sparse.csr_matrix]:
-        """Residuals and their Jacobian with respect to (δt, δω) of every body."""
+    def evaluate(self, rotation: np.ndarray, shift: np.ndarray) -> tuple[np.ndarray, tuple]:
+        """Residuals, and what :meth:`jacobian` needs to differentiate them."""
         x = self.place(self.points0, self.owner, rotation, shift)
         current = self.atoms(rotation, shift)
         # vector terms: W (x_b - x_a), one residual per row of W
@@ -317,8 +317,13 @@ class _Problem:
         xa, xb = np.concatenate([x[a], pair_a]), np.concatenate([x[b], pair_b])
         oa = np.concatenate([self.owner[a], self.owner[self.distance_a], self.body_of_atom[i]])
         ob = np.concatenate([self.owner[b], self.owner[self.distance_b], self.body_of_atom[j]])
-        # d(direction . x)/d(δt, δω) = (direction, (x - c) x direction) for the body of x
-        centre = self.centres + shift
+        return residual, (xa, xb, oa, ob, direction, self.centres + shift)
+
+    def jacobian(self, terms: tuple) -> sparse.csr_matrix:
+        """The Jacobian of the residuals with respect to (δt, δω) of every body: each residual
+        is ``direction . x_b - direction . x_a`` to first order, and
+        ``d(direction . x)/d(δt, δω) = (direction, (x - c) x direction)`` for the body of x."""
+        xa, xb, oa, ob, direction, centre = terms
         rows, cols, vals = [], [], []
         for xyz, owner, sign in ((xb, ob, 1.0), (xa, oa, -1.0)):
             moving = np.flatnonzero(owner >= 0)
@@ -327,16 +332,16 @@ class _Problem:
             rows.append(np.repeat(moving, 6))
             cols.append((6 * body[:, None] + np.arange(6)).ravel())
             vals.append(sign * np.concatenate([direction[moving], lever], axis=1).ravel())
-        jacobian = sparse.csr_matrix(
-            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(len(residual), 6 * self.n_bodies)
+        return sparse.csr_matrix(
+            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(len(direction), 6 * self.n_bodies)
         )
-        return residual, jacobian
 
     def solve(self) -> Relaxation:
         """Levenberg–Marquardt from the start positions."""
         rotation = np.broadcast_to(np.eye(3), (self.n_bodies, 3, 3)).copy()
         shift = np.zeros((self.n_bodies, 3))
-        residual, jacobian = self.evaluate(rotation, shift)
+        residual, terms = self.evaluate(rotation, shift)
+        jacobian = self.jacobian(terms)
         cost = 0.5 * residual @ residual
         damping = DAMPING
         iterations = 0
@@ -344,10 +349,10 @@ class _Problem:
             step = -_solve_normal(jacobian, residual, damping)
             predicted = cost - 0.5 * np.sum((residual + jacobian @ step) ** 2)
             trial = _moved(rotation, shift, step)
-            trial_residual, trial_jacobian = self.evaluate(*trial)
+            trial_residual, terms = self.evaluate(*trial)
             trial_cost = 0.5 * trial_residual @ trial_residual
             if trial_cost < cost:
-                (rotation, shift), residual, jacobian, cost = trial, trial_residual, trial_jacobian, trial_cost
+                (rotation, shift), residual, jacobian, cost = trial, trial_residual, self.jacobian(terms), trial_cost
                 damping = max(damping / 3, 1e-7)
                 if predicted < TOLERANCE * cost:
                     break
