@@ -413,10 +413,10 @@ def _shift(rows: np.ndarray | slice, offset: int, n: int, width: int = 1) -> np.
 
 
 def _glyph_points(centres: np.ndarray, template: np.ndarray) -> np.ndarray:
-    """``template`` (v, 3) placed at every centre (n, 3): (n * v, 3), by one matrix product."""
+    """``template`` (v, 3) placed at every centre (n, 3): (n * v, 3), one small product per centre."""
     v = len(template)
     placement = np.vstack([np.tile(np.eye(3), v), template.reshape(1, -1)])
-    return np.einsum("nk,kc->nc", np.column_stack([centres, np.ones(len(centres))]), placement).reshape(-1, 3)
+    return (np.column_stack([centres, np.ones(len(centres))])[:, None, :] @ placement).reshape(-1, 3)
 
 
 def _cells(blocks: list[np.ndarray]) -> np.ndarray:

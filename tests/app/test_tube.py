@@ -77,3 +77,9 @@ def test_faces_join_consecutive_rings_and_caps_close_the_ends() -> None:
     rim = np.arange(24.0).reshape(8, 3)
     points, normals = tube.cap_vertices(np.zeros(3), rim, np.array([0.0, 0.0, 1.0]))
     assert points.shape == (9, 3) and np.all(normals == [0.0, 0.0, 1.0])
+
+
+def test_cross_is_numpys() -> None:
+    rng = np.random.default_rng(3)
+    a, b = rng.normal(size=(2, 40, 3))
+    np.testing.assert_allclose(tube.cross(a, b), np.cross(a, b), rtol=1e-14, atol=1e-14)
