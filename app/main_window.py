@@ -108,12 +108,16 @@ class MainWindow(QMainWindow):
 
     def save(self) -> bool:
         """Save to the file chosen by the last Save As; the first Save of a file asks where."""
+        if self.document.model is None:
+            return False
         if self.document.save_path is None:
             return self.save_as()
         return self._write(self.document.save_path)
 
     def save_as(self) -> bool:
         """Ask for a file name (PDB or mmCIF by its extension) and save there."""
+        if self.document.model is None:
+            return False
         source = self.document.path
         folder = Path.home() if source is None or source.parent == EXAMPLES_DIR else source.parent
         stem = source.name.split(".")[0] if source is not None else "structure"

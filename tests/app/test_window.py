@@ -483,3 +483,13 @@ def test_every_test_entry_opens_and_takes_a_drag(window: MainWindow, errors: lis
         assert len(_moved_residues(document, original)) > 0, path.name
         window.undo_action.trigger()
         assert np.array_equal(document.model.coords, original), path.name
+
+
+def test_an_empty_window_refuses_to_save(qtbot: QtBot, errors: list[str]) -> None:
+    window = MainWindow()
+    qtbot.addWidget(window)
+    window.show()
+    assert window.windowTitle() == "untitled[*] — ribbonwave" and window.status_labels["file"].text() == "no structure"
+    assert not window.open_file(DATA / "1BNA.pdb.gz")  # DNA only: no protein to edit
+    assert "no protein chain" in errors[0]
+    assert not window.save() and not window.save_as()
