@@ -80,7 +80,6 @@ class Document(QObject):
         self.pick: Pick | None = None
         self._curves: dict[int, LevelCurve] = {}
         self._preview: Edit | None = None
-        self._labels: list[tuple[str, ...]] = []
 
     # ------------------------------------------------------------------ state
 
@@ -124,11 +123,11 @@ class Document(QObject):
 
     def labels(self, segment: int | None = None) -> tuple[str, ...]:
         """Residue labels of ``segment`` (default: the current one), e.g. ``'A:LYS48'``."""
-        return self._labels[self.segment if segment is None else segment]
+        return self.structure.segments[self.segment if segment is None else segment].labels
 
     def segment_label(self, segment: int) -> str:
         """E.g. ``'A  MET1–GLY76 (76 residues)'``."""
-        labels = self._labels[segment]
+        labels = self.labels(segment)
         chain = self.structure.segments[segment].chain
         return f"{chain}  {labels[0].split(':')[1]}–{labels[-1].split(':')[1]} ({len(labels)} residues)"
 
@@ -241,7 +240,6 @@ class Document(QObject):
         self.model = model
         self.paths = [SegmentPath(ribbon) for ribbon in model.ribbons]
         self.ca_rows = ca_rows(model.structure)
-        self._labels = [segment.labels for segment in model.structure.segments]
         self.segment = 0
         self.level = float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
         self.pick = None

@@ -19,6 +19,11 @@ from .ribbon import Ribbon, RibbonKind, segment_ribbon
 from .structure import BackboneSegment, Structure, write_structure
 
 
+NEGLIGIBLE_MOVE = 1e-6
+"""Control-point changes up to this size (Å) move no residue: fractional-level edits have
+exponentially decaying tails over the whole segment that would otherwise remap it all."""
+
+
 @dataclass(frozen=True, eq=False)
 class Edit:
     """One change of one segment: its ribbon control points and the atoms that moved.
@@ -92,7 +97,7 @@ class EditableModel:
         """The edit that gives segment ``segment`` the finest control points ``new_points``."""
         ribbon = self._ribbon(segment)
         new_ribbon = ribbon.with_points(new_points)
-        moved_segments = changed_segments(new_ribbon.points - ribbon.points)
+        moved_segments = changed_segments(new_ribbon.points - ribbon.points, tolerance=NEGLIGIBLE_MOVE)
         residues = ribbon.residue_segments(moved_segments)
         rows, owner = _residue_rows(self.segments[segment], residues)
         u = ribbon.residue_u[residues]

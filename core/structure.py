@@ -37,6 +37,7 @@ import os
 import tempfile
 import zlib
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import gemmi
@@ -118,7 +119,7 @@ class BackboneSegment:
         """Rows of ``Structure.coords`` holding the atoms of residue ``i``."""
         return slice(int(self.atom_start[i]), int(self.atom_stop[i]))
 
-    @property
+    @cached_property
     def labels(self) -> tuple[str, ...]:
         """Residue labels such as ``'A:LYS48'`` or ``'A:SER52A'``."""
         return tuple(

@@ -132,3 +132,16 @@ def test_every_segment_of_a_multichain_entry_is_editable():
     assert np.array_equal(model.coords[chain_a_rows], structure.coords[chain_a_rows])
     with pytest.raises(ValueError, match="segment must be in"):
         model.move_point(len(model.ribbons), 3, 0, [1.0, 0.0, 0.0])
+
+
+def test_fractional_edits_stay_local():
+    """The tails of a fractional-level edit below NEGLIGIBLE_MOVE move no residue."""
+    structure = read_structure(DATA / "1TIM.pdb.gz")
+    model = EditableModel(structure)
+    ribbon = model.ribbons[0]  # 247 residues, J = 8, maximum level 7.95
+    edit = model.move_point(0, 7.5, 60, [2.0, 0.0, 0.0])
+    assert 4 < len(edit.residues) < len(ribbon.residue_u) // 2
+    full = ribbon.residue_points()
+    moved_curve = ribbon.with_points(edit.new_points).residue_points()
+    still = np.setdiff1d(np.arange(len(full)), edit.residues)
+    assert np.abs(moved_curve[still] - full[still]).max() < 1e-5
