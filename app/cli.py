@@ -15,13 +15,10 @@ from pathlib import Path
 from typing import NamedTuple
 
 from app import DEFAULT_STRUCTURE, analysis_commands, structure_commands, surface_commands, validate_commands
+from app.structure_commands import InputError
 
 PROG = "ribbonwave"
 DEFAULT_COMMAND = "open"
-
-
-class CommandError(Exception):
-    """A failure the user can act on: reported as one line on stderr, exit status 1."""
 
 
 class Command(NamedTuple):
@@ -70,16 +67,16 @@ def _open(args: argparse.Namespace) -> int:
     from core.structure import StructureError
 
     if args.level is not None and not args.level >= 0:
-        raise CommandError(f"--level must be >= 0; got {args.level:g}")
+        raise InputError(f"--level must be >= 0; got {args.level:g}")
     if sys.platform.startswith("linux") and not any(map(os.environ.get, ("DISPLAY", "WAYLAND_DISPLAY",
                                                                          "QT_QPA_PLATFORM"))):
-        raise CommandError("no display to open a window on; run under xvfb-run (scripts/ribbonwave.sh does)")
+        raise InputError("no display to open a window on; run under xvfb-run (scripts/ribbonwave.sh does)")
     app = QApplication.instance() or QApplication(sys.argv[:1])
     document = Document()
     try:
         document.open(args.file, args.ribbon)
     except StructureError as error:
-        raise CommandError(str(error)) from error
+        raise InputError(str(error)) from error
     if args.level is not None:
         document.set_level(args.level)
     window = MainWindow(document)
@@ -91,7 +88,7 @@ def _open(args: argparse.Namespace) -> int:
     try:
         window.save_screenshot(args.screenshot)
     except OSError as error:
-        raise CommandError(str(error)) from error
+        raise InputError(str(error)) from error
     finally:
         window.close()
     return 0
@@ -140,7 +137,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(args_list)
     try:
         return args.run(args)
-    except (CommandError, structure_commands.InputError) as error:
+    except InputError as error:
         print(f"{PROG}: error: {error}", file=sys.stderr)
         return 1
     except BrokenPipeError:  # output piped into a reader that stopped early (e.g. head)

@@ -26,7 +26,7 @@ CURVE_COLUMNS = ("chain", "segment", "resseq", "icode", "resname", "ss",
 
 
 class InputError(Exception):
-    """Bad input the user can fix: one line on stderr, exit status 1."""
+    """Bad input the user can fix (any command): one line on stderr, exit status 1."""
 
 
 def load(path: Path) -> Structure:
