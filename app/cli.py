@@ -8,6 +8,7 @@ handler, and one line of help. ``ribbonwave --help`` lists them all.
 
 import argparse
 import os
+import re
 import signal
 import sys
 from collections.abc import Callable, Sequence
@@ -19,6 +20,8 @@ from app.structure_commands import InputError
 
 PROG = "ribbonwave"
 DEFAULT_COMMAND = "open"
+VECTOR_OPTIONS = ("--move",)
+"""Options whose value is a comma-separated vector that may start with a minus sign."""
 
 
 class Command(NamedTuple):
@@ -129,9 +132,20 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _attach_negative_vectors(args: list[str]) -> list[str]:
+    """Write ``--move -3,4,0`` as ``--move=-3,4,0``: argparse takes '-3,4,0' for an option."""
+    glued: list[str] = []
+    for arg in args:
+        if glued and glued[-1] in VECTOR_OPTIONS and re.fullmatch(r"-[0-9.][0-9.,eE+-]*", arg):
+            glued[-1] = f"{glued[-1]}={arg}"
+        else:
+            glued.append(arg)
+    return glued
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``ribbonwave`` with ``argv`` (default: ``sys.argv[1:]``) and return the exit status."""
-    args_list = list(sys.argv[1:] if argv is None else argv)
+    args_list = _attach_negative_vectors(list(sys.argv[1:] if argv is None else argv))
     if not args_list or (args_list[0] not in COMMANDS and args_list[0] not in ("-h", "--help")):
         args_list.insert(0, DEFAULT_COMMAND)
     args = build_parser().parse_args(args_list)

@@ -151,6 +151,13 @@ def test_bad_input_is_one_line_and_exit_status_1(capsys, tmp_path, monkeypatch, 
     assert re.search(message, err)
 
 
+def test_negative_displacements_need_no_equals_sign(capsys, tmp_path):
+    out = tmp_path / "left.pdb"
+    status, printed, _ = run(capsys, "edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "4",
+                             "--point", "8", "--move", "-3,4,-0.5", "-o", out)
+    assert status == 0 and "moved 32 residues" in printed
+
+
 def test_usage_errors_exit_2(capsys):
     with pytest.raises(SystemExit) as exit_info:
         main(["edit", str(DATA / "1UBQ.pdb.gz"), "--chain", "A", "--level", "3", "--point", "1", "--move", "1,0",
