@@ -59,6 +59,21 @@ def _open_arguments(parser: argparse.ArgumentParser) -> None:
         default="peptide",
         help="peptide-plane ribbon (default) or the curve through the Cα atoms",
     )
+    parser.add_argument(
+        "--compare",
+        nargs="+",
+        default=[],
+        metavar="FILE[:CHAIN]",
+        help="structures to superpose on the edited chain and show at the same depth below their top level, "
+        "each in its own colour (default chain: the longest)",
+    )
+    parser.add_argument(
+        "--hide",
+        nargs="+",
+        default=[],
+        metavar="LAYER",
+        help="layers to start hidden, e.g. tube control-points (see the Display dock)",
+    )
 
 
 def _open(args: argparse.Namespace) -> int:
@@ -67,6 +82,7 @@ def _open(args: argparse.Namespace) -> int:
 
     from app.document import Document
     from app.main_window import MainWindow
+    from app.scene import Layer
     from core.structure import StructureError
 
     if args.level is not None and not args.level >= 0:
@@ -83,6 +99,20 @@ def _open(args: argparse.Namespace) -> int:
     if args.level is not None:
         document.set_level(args.level)
     window = MainWindow(document)
+    for name in args.hide:
+        layer = Layer.__members__.get(name.upper().replace("-", "_"))
+        if layer is None:
+            window.close()
+            names = ", ".join(member.lower().replace("_", "-") for member in Layer.__members__)
+            raise InputError(f"--hide: no layer {name!r}; layers: {names}")
+        window.display_panel.layer_boxes[layer].setChecked(False)
+    for spec in args.compare:
+        path, chain = _file_and_chain(spec)
+        try:
+            window.comparison.add(path, chain)
+        except (StructureError, ValueError) as error:
+            window.close()
+            raise InputError(f"--compare {spec}: {error}") from error
     window.show()
     if args.screenshot is None:
         signal.signal(signal.SIGINT, signal.SIG_DFL)  # let Ctrl+C in the terminal end the event loop
@@ -95,6 +125,16 @@ def _open(args: argparse.Namespace) -> int:
     finally:
         window.close()
     return 0
+
+
+def _file_and_chain(spec: str) -> tuple[Path, str | None]:
+    """``FILE`` or ``FILE:CHAIN`` (a chain only when ``FILE`` itself does not exist)."""
+    path = Path(spec)
+    if not path.exists() and ":" in spec:
+        name, chain = spec.rsplit(":", 1)
+        if chain and Path(name).exists():
+            return Path(name), chain
+    return path, None
 
 
 COMMANDS: dict[str, Command] = {

@@ -39,6 +39,8 @@ from PySide6.QtWidgets import (
 from app import EXAMPLES_DIR
 from app.document import Document
 from app.drag import DragController, Mode, PointerEvent
+from app.overlay import Comparison, ComparisonView
+from app.overlay_panel import ComparisonPanel
 from app.panels import DisplayPanel, RibbonDimensionPanel
 from app.picking import PRIORITY, PointerAdapter
 from app.scene import Layer, Scene
@@ -76,10 +78,14 @@ class MainWindow(QMainWindow):
 
         self.dimension_panel = RibbonDimensionPanel(self.document)
         self.display_panel = DisplayPanel(self.scene)
+        self.comparison = Comparison(self.document)  # after the scene: it redraws once the scene is rebuilt
+        self.comparison_view = ComparisonView(self.comparison, self.plotter)
+        self.comparison_panel = ComparisonPanel(self.comparison)
         self.history = QUndoView(self.document.undo_stack)
         self.history.setEmptyLabel("<structure as read>")
         docks = [self._dock("Ribbon dimension", self.dimension_panel), self._dock("Display", self.display_panel),
-                 self._dock("Undo history", self.history)]
+                 self._dock("Undo history", self.history),
+                 self._dock("Compared structures", self.comparison_panel)]
         self._create_actions()
         self._create_menus(docks)
         self._create_status_bar()
@@ -258,6 +264,7 @@ class MainWindow(QMainWindow):
         file_menu.addAction(self.open_action)
         self.recent_menu = file_menu.addMenu("Open &Recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
+        file_menu.addAction("Add Structures for &Comparison…", self.comparison_panel.add_dialog)
         file_menu.addSeparator()
         file_menu.addActions([self.save_action, self.save_as_action, self.export_action])
         file_menu.addSeparator()
