@@ -22,6 +22,7 @@ from app.commands import EditCommand
 from app.curves import LevelCurve, SegmentPath
 from app.molecule import ca_rows
 from core.model import Edit, EditableModel
+from core.regularize import FLANK, regularized, relax
 from core.ribbon import RibbonKind
 from core.structure import Structure, read_structure
 
@@ -78,6 +79,10 @@ class Document(QObject):
         self.level = 0.0
         self.multiresolution = True
         self.pick: Pick | None = None
+        self.regularize_on_release = True
+        """A drag's undo step holds the edit followed by :func:`core.regularize.regularized`."""
+        self.regularize_while_dragging = False
+        """Every preview is regularized (30–80 ms a step: off by default)."""
         self._curves: dict[int, LevelCurve] = {}
         self._preview: Edit | None = None
 
@@ -196,10 +201,20 @@ class Document(QObject):
         """Show the level curve dragged at parameter ``u`` by ``displacement`` (Å) from the drag start."""
         self._preview_edit(lambda: self._model.tug(self.segment, self.shown_level(), u, displacement))
 
+    def set_regularization(self, *, on_release: bool | None = None, while_dragging: bool | None = None) -> None:
+        """Regularize drags when they end and/or at every preview (None: leave as it is)."""
+        if on_release is not None:
+            self.regularize_on_release = on_release
+        if while_dragging is not None:
+            self.regularize_while_dragging = while_dragging
+
     def finish_drag(self, text: str) -> None:
-        """End a drag: the previewed edit becomes one undo step named ``text`` (none if nothing moved)."""
+        """End a drag: the previewed edit (regularized if asked) becomes one undo step named
+        ``text`` (none if nothing moved)."""
         edit, self._preview = self._preview, None
         if edit is not None and not np.array_equal(edit.old_points, edit.new_points):
+            if self.regularize_on_release and not self.regularize_while_dragging:  # else the preview is regularized
+                edit = regularized(self._model, edit)
             self.undo_stack.push(EditCommand(self, edit, text))
 
     def cancel_drag(self) -> None:
@@ -207,6 +222,14 @@ class Document(QObject):
         edit, self._preview = self._preview, None
         if edit is not None:
             self.revert_edit(edit)
+
+    def regularize_region(self, residues: np.ndarray) -> None:
+        """Regularize ``residues`` (indices within the current segment) and up to FLANK neighbours
+        on each side as one undo step: ideal junctions, on the current curve, and no clash
+        that the structure as read did not have."""
+        edit = _region_edit(self._model, self.segment, np.asarray(residues, dtype=np.int64))
+        if not np.array_equal(edit.old_coords, edit.new_coords):
+            self.undo_stack.push(EditCommand(self, edit, f"Regularize {self.residue_range(edit.residues)}"))
 
     def apply_edit(self, edit: Edit) -> None:
         """Carry out ``edit`` (undo commands call this)."""
@@ -252,6 +275,8 @@ class Document(QObject):
         if previous is not None:
             self._model.revert(previous)
         edit = plan()
+        if self.regularize_while_dragging:
+            edit = regularized(self._model, edit)
         self._model.apply(edit)
         self._preview = edit
         if previous is None:
@@ -275,6 +300,20 @@ class Document(QObject):
             return
         self.pick = pick
         self.picked.emit()
+
+
+def _region_edit(model: EditableModel, segment: int, residues: np.ndarray) -> Edit:
+    """The edit that relaxes ``residues`` of ``segment`` and their flanks (see :func:`core.regularize.relax`),
+    tethered to the current curve; pairs may keep the overlap they had in the structure as read."""
+    n_residues = len(model.segments[segment])
+    spread = (residues[:, None] + np.arange(-FLANK, FLANK + 1)).ravel()
+    free = np.unique(spread[(spread >= 0) & (spread < n_residues)])
+    ribbon = model.ribbons[segment]
+    u = ribbon.residue_u[free]
+    result = relax(model.structure, model.coords, model.segments[segment].residue_index[free],
+                   ribbon.space.evaluate(ribbon.points, u), ribbon.space.evaluate(ribbon.points, u, 1),
+                   model.structure.coords)
+    return Edit(segment, ribbon.points, ribbon.points, free, result.rows, model.coords[result.rows], result.coords)
 
 
 def _union(a: np.ndarray, b: np.ndarray, size: int) -> np.ndarray:

@@ -53,9 +53,10 @@ class Layer(StrEnum):
     ATOMS = "atoms"
     LIGANDS = "ligands"
     IONS = "ions"
+    VALIDATION = "validation markers"
 
 
-DEFAULT_LAYERS = {Layer.TUBE, Layer.CURVE, Layer.CONTROL_POINTS, Layer.LIGANDS, Layer.IONS}
+DEFAULT_LAYERS = {Layer.TUBE, Layer.CURVE, Layer.CONTROL_POINTS, Layer.LIGANDS, Layer.IONS, Layer.VALIDATION}
 
 _ACTORS: dict[Layer, tuple[str, ...]] = {
     Layer.TUBE: ("tube",),
@@ -65,6 +66,7 @@ _ACTORS: dict[Layer, tuple[str, ...]] = {
     Layer.ATOMS: ("atoms",),
     Layer.LIGANDS: ("ligand_balls", "ligand_sticks"),
     Layer.IONS: ("ions",),
+    Layer.VALIDATION: ("validation_markers",),  # drawn by app.validation_markers
 }
 _SHINY = {"interpolation": "phong", "specular": 0.4, "specular_power": 25.0}
 

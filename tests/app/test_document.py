@@ -46,6 +46,7 @@ def test_deviation_is_carsons_rms_of_ca_to_curve(ubiquitin: Document) -> None:
 
 
 def test_a_drag_is_previewed_from_its_start_and_pushed_once(ubiquitin: Document, qtbot: QtBot) -> None:
+    ubiquitin.set_regularization(on_release=False)  # Carson's plain edit (regularization: test_validation_panel)
     original = ubiquitin.model.coords.copy()
     changes: list[Change] = []
     ubiquitin.changed.connect(changes.append)

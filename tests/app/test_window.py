@@ -199,6 +199,7 @@ def test_dragging_a_control_point_edits_the_structure(
     window: MainWindow, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, level: object, expected: int
 ) -> None:
     document = window.document
+    document.set_regularization(on_release=False)  # Carson's plain edit (regularization: test_validation_panel)
     document.set_level(document.max_level if level == "max" else level)
     window.plotter.render()
     original = document.model.coords.copy()
