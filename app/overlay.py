@@ -113,8 +113,7 @@ def fit_chain(fixed_ca: np.ndarray, fixed: Sequence[BackboneSegment], moving: Se
         if close.sum() < MIN_PAIRS or np.array_equal(close, core):
             break
         core = close
-    rms = lambda d: float(np.sqrt(np.mean(d**2)))  # noqa: E731
-    return ChainFit(motion, len(a), int(core.sum()), rms(distance[core]), rms(distance), pairing)
+    return ChainFit(motion, len(a), int(core.sum()), _rms(distance[core]), _rms(distance), pairing)
 
 
 @dataclass(eq=False)
@@ -265,6 +264,7 @@ class ComparisonView(QObject):
         comparison.document.levelChanged.connect(self._update)  # a new segment changes the level too
 
     def actor_name(self, item: Compared) -> str:
+        """Name of the plotter actor of ``item``'s tube."""
         return f"compared_{item.key}"
 
     def _rebuild(self) -> None:
@@ -308,10 +308,15 @@ class ComparisonView(QObject):
             points.append(ring_points)
             normals.append(radial)
         mesh = self.meshes[self.comparison.items[index].key]
-        for target, values in ((mesh.GetPoints().GetData(), points), (mesh.GetPointData().GetArray("Normals"), normals)):
+        arrays = (mesh.GetPoints().GetData(), mesh.GetPointData().GetArray("Normals"))
+        for target, values in zip(arrays, (points, normals)):
             vtk_to_numpy(target)[:] = np.vstack(values)
             target.Modified()
         mesh.Modified()
+
+
+def _rms(distances: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(distances**2)))
 
 
 def _tangents(samples: np.ndarray) -> np.ndarray:
