@@ -2,7 +2,7 @@
 
 :class:`LiveValidation` validates the whole structure when it is loaded; after that each
 :class:`~app.document.Change` (a drag preview, an undo, a regularization) re-checks only
-the residues that moved, with what they touch, and folds that local report into the
+the residues that moved, with what they touch (all of them when more than half moved), and folds that local report into the
 current one (:meth:`core.validation.ValidationReport.updated`). Every atom outside a
 change is where it was when the report described it, so the folded report is the report
 of the current coordinates. Views follow :attr:`LiveValidation.updated`.
@@ -16,6 +16,9 @@ from PySide6.QtCore import QObject, Signal
 
 from app.document import Change, Document
 from core.validation import ValidationReport, validate
+
+LOCAL_FRACTION = 0.5
+"""A change of more than this fraction of the residues is checked in full (as fast, and exact)."""
 
 
 class LiveValidation(QObject):
@@ -43,9 +46,12 @@ class LiveValidation(QObject):
         self._done(start, local=False)
 
     def _check_change(self, change: Change) -> None:
-        start = time.perf_counter()
         structure = self.document.structure
         residues = structure.segments[change.segment].residue_index[change.residues]
+        if len(residues) > LOCAL_FRACTION * structure.n_residues:
+            self._check_all()
+            return
+        start = time.perf_counter()
         self.report = self.report.updated(validate(structure, self.document.model.coords, residues=residues))
         self._done(start, local=True)
 

@@ -31,6 +31,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QMainWindow,
     QMessageBox,
+    QScrollArea,
     QStyle,
     QUndoView,
     QWidget,
@@ -39,11 +40,14 @@ from PySide6.QtWidgets import (
 from app import EXAMPLES_DIR
 from app.document import Document
 from app.drag import DragController, Mode, PointerEvent
+from app.live_validation import LiveValidation
 from app.overlay import Comparison, ComparisonView
 from app.overlay_panel import ComparisonPanel
 from app.panels import DisplayPanel, RibbonDimensionPanel
 from app.picking import PRIORITY, PointerAdapter
 from app.scene import Layer, Scene
+from app.validation_markers import ValidationMarkers
+from app.validation_panel import ValidationPanel
 from core.structure import StructureError
 
 APP_NAME = "ribbonwave"
@@ -72,7 +76,9 @@ class MainWindow(QMainWindow):
         self.plotter.enable_anti_aliasing("fxaa")
         self._smooth_still_frames_only()
         self.setCentralWidget(self.plotter)
+        self.validation = LiveValidation(self.document)  # before the scene: its report is new when the scene renders
         self.scene = Scene(self.document, self.plotter)
+        self.markers = ValidationMarkers(self.validation, self.scene)
         self.controller = DragController(self.document)
         self.pointer = PointerAdapter(self.plotter, self._on_pointer)
 
@@ -81,11 +87,14 @@ class MainWindow(QMainWindow):
         self.comparison = Comparison(self.document)  # after the scene: it redraws once the scene is rebuilt
         self.comparison_view = ComparisonView(self.comparison, self.plotter)
         self.comparison_panel = ComparisonPanel(self.comparison)
+        self.validation_panel = ValidationPanel(self.validation)
         self.history = QUndoView(self.document.undo_stack)
         self.history.setEmptyLabel("<structure as read>")
         docks = [self._dock("Ribbon dimension", self.dimension_panel), self._dock("Display", self.display_panel),
-                 self._dock("Undo history", self.history),
+                 self._dock("Undo history", self.history), self._dock("Validation", _scrolled(self.validation_panel)),
                  self._dock("Compared structures", self.comparison_panel)]
+        self.tabifyDockWidget(docks[2], docks[3])  # validation and history share a place: the window stays small
+        docks[3].raise_()
         self._create_actions()
         self._create_menus(docks)
         self._create_status_bar()
@@ -95,6 +104,7 @@ class MainWindow(QMainWindow):
         self.document.levelChanged.connect(self._update_status)
         self.document.segmentChanged.connect(self._update_status)
         self.document.picked.connect(self._update_status)
+        self.document.picked.connect(self._update_regularize_action)
         self._update_title()
         self._update_status()
 
@@ -238,6 +248,10 @@ class MainWindow(QMainWindow):
         self.redo_action.setIcon(icon(pixmap.SP_ArrowForward))
         self.redo_action.setIconText("Redo")
         self.cancel_action = self._action("Cancel Drag / Deselect", QKeySequence(Qt.Key.Key_Escape), self._cancel)
+        self.regularize_action = self._action("Re&gularize Region", QKeySequence("Ctrl+G"), self._regularize_region)
+        self.regularize_action.setToolTip("Ideal peptide junctions and no new clashes for the residues of the picked "
+                                          "point and three on each side (one undo step)")
+        self.regularize_action.setEnabled(False)
         self.reset_view_action = self._action("&Reset View", QKeySequence("Ctrl+R"), self._reset_view,
                                               icon(pixmap.SP_BrowserReload))
         self.mode_actions = QActionGroup(self)
@@ -273,6 +287,8 @@ class MainWindow(QMainWindow):
         edit_menu.addActions([self.undo_action, self.redo_action, self.cancel_action])
         edit_menu.addSeparator()
         edit_menu.addActions(self.mode_actions.actions())
+        edit_menu.addSeparator()
+        edit_menu.addAction(self.regularize_action)
         view_menu = menu.addMenu("&View")
         view_menu.addAction(self.reset_view_action)
         view_menu.addSeparator()
@@ -327,6 +343,13 @@ class MainWindow(QMainWindow):
             self.controller.cancel()
         elif self.document.model is not None:
             self.document.pick_point(None)
+
+    def _regularize_region(self) -> None:
+        if self.document.pick is not None:
+            self.document.regularize_region(self.document.pick.residues)
+
+    def _update_regularize_action(self) -> None:
+        self.regularize_action.setEnabled(self.document.pick is not None)
 
     def _reset_view(self) -> None:
         self.scene.reset_camera()
@@ -388,3 +411,11 @@ class MainWindow(QMainWindow):
         pixels = np.ascontiguousarray(self.plotter.screenshot(return_img=True))
         height, width = pixels.shape[:2]
         return QImage(pixels.data, width, height, 3 * width, QImage.Format.Format_RGB888).copy()
+
+
+def _scrolled(widget: QWidget) -> QScrollArea:
+    """``widget`` in a scroll area: a tall panel does not make the window taller."""
+    area = QScrollArea()
+    area.setWidget(widget)
+    area.setWidgetResizable(True)
+    return area
