@@ -46,6 +46,7 @@ from app.overlay_panel import ComparisonPanel
 from app.panels import DisplayPanel, RibbonDimensionPanel
 from app.picking import PRIORITY, PointerAdapter
 from app.scene import Layer, Scene
+from app.surface_panel import SurfaceLayer, SurfacePanel
 from app.validation_markers import ValidationMarkers
 from app.validation_panel import ValidationPanel
 from core.structure import StructureError
@@ -88,11 +89,16 @@ class MainWindow(QMainWindow):
         self.comparison_view = ComparisonView(self.comparison, self.plotter)
         self.comparison_panel = ComparisonPanel(self.comparison)
         self.validation_panel = ValidationPanel(self.validation)
+        self.surface_layer = SurfaceLayer(self.document, self.plotter)  # after the scene, which clears the view on load
+        self.surface_panel = SurfacePanel(self.surface_layer)
         self.history = QUndoView(self.document.undo_stack)
         self.history.setEmptyLabel("<structure as read>")
         docks = [self._dock("Ribbon dimension", self.dimension_panel), self._dock("Display", self.display_panel),
                  self._dock("Undo history", self.history), self._dock("Validation", _scrolled(self.validation_panel)),
                  self._dock("Compared structures", self.comparison_panel)]
+        docks.append(self._dock("Surface", self.surface_panel))
+        self.tabifyDockWidget(docks[1], docks[-1])  # beside the ribbon's display options
+        docks[1].raise_()
         self.tabifyDockWidget(docks[2], docks[3])  # validation and history share a place: the window stays small
         docks[3].raise_()
         self._create_actions()
@@ -204,6 +210,7 @@ class MainWindow(QMainWindow):
         if not self.maybe_save():
             event.ignore()
             return
+        self.surface_layer.shutdown()
         self.pointer.close()
         self.plotter.close()
         super().closeEvent(event)

@@ -122,6 +122,15 @@ def to_polydata(mesh: TriangleMesh, scalars: np.ndarray | None = None, name: str
     return polydata
 
 
+def scalar_style(colouring: str, scalars: np.ndarray) -> tuple[str, tuple[float, float]]:
+    """Colour map and range for per-vertex ``scalars`` of ``colouring``: the potential
+    symmetric about 0 (95th percentile of |value|), curvature ±0.5 1/Å, B-factors 2–98%."""
+    limit = float(np.percentile(np.abs(scalars), 95)) or 1.0
+    low, high = np.percentile(scalars, [2, 98])
+    clim = {"potential": (-limit, limit), "curvature": (-0.5, 0.5)}.get(colouring, (float(low), float(high)))
+    return {"potential": "bwr_r", "curvature": "PiYG"}.get(colouring, "viridis"), clim
+
+
 def _write(mesh: TriangleMesh, scalars: np.ndarray | None, colouring: str | None, path: Path) -> None:
     """Write atomically: to a temporary file beside ``path``, then rename."""
     polydata = to_polydata(mesh, scalars, colouring or "values")
@@ -148,10 +157,7 @@ def _render(polydata, scalars: np.ndarray | None, colouring: str | None, path: s
         if scalars is None:
             plotter.add_mesh(polydata, color="lightsteelblue", smooth_shading=True)
         else:
-            limit = float(np.percentile(np.abs(scalars), 95)) or 1.0
-            clim = {"potential": (-limit, limit), "curvature": (-0.5, 0.5)}.get(
-                colouring, tuple(np.percentile(scalars, [2, 98])))
-            cmap = {"potential": "bwr_r", "curvature": "PiYG"}.get(colouring, "viridis")
+            cmap, clim = scalar_style(colouring, scalars)
             plotter.add_mesh(polydata, scalars=colouring, cmap=cmap, clim=clim, smooth_shading=True,
                              scalar_bar_args={"title": f"{colouring} ({UNITS[colouring]})"})
         plotter.set_background("white")
