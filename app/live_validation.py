@@ -2,10 +2,11 @@
 
 :class:`LiveValidation` validates the whole structure when it is loaded; after that each
 :class:`~app.document.Change` (a drag preview, an undo, a regularization) re-checks only
-the residues that moved, with what they touch (all of them when more than half moved), and folds that local report into the
-current one (:meth:`core.validation.ValidationReport.updated`). Every atom outside a
-change is where it was when the report described it, so the folded report is the report
-of the current coordinates. Views follow :attr:`LiveValidation.updated`.
+the residues that moved, with what they touch, and folds that local report into the
+current one (:meth:`core.validation.ValidationReport.updated`); a change that moves more
+than half of the residues is checked in full. Every atom outside a change is where it was
+when the report described it, so the folded report is the report of the current
+coordinates. Views follow :attr:`LiveValidation.updated`.
 """
 
 from __future__ import annotations

@@ -93,7 +93,8 @@ class MainWindow(QMainWindow):
         self.surface_panel = SurfacePanel(self.surface_layer)
         self.history = QUndoView(self.document.undo_stack)
         self.history.setEmptyLabel("<structure as read>")
-        docks = [self._dock("Ribbon dimension", self.dimension_panel), self._dock("Display", _scrolled(self.display_panel)),
+        docks = [self._dock("Ribbon dimension", self.dimension_panel),
+                 self._dock("Display", _scrolled(self.display_panel)),
                  self._dock("Undo history", self.history), self._dock("Validation", _scrolled(self.validation_panel)),
                  self._dock("Compared structures", self.comparison_panel)]
         docks.append(self._dock("Surface", self.surface_panel))
