@@ -113,6 +113,8 @@ def _open(args: argparse.Namespace) -> int:
         except (StructureError, ValueError) as error:
             window.close()
             raise InputError(f"--compare {spec}: {error}") from error
+    if args.compare:
+        window.comparison_panel.parentWidget().raise_()  # the dock listing them in front of its tab group
     window.show()
     if args.screenshot is None:
         signal.signal(signal.SIGINT, signal.SIG_DFL)  # let Ctrl+C in the terminal end the event loop

@@ -101,6 +101,7 @@ class MainWindow(QMainWindow):
         self.tabifyDockWidget(docks[1], docks[-1])  # beside the ribbon's display options
         docks[1].raise_()
         self.tabifyDockWidget(docks[2], docks[3])  # validation and history share a place: the window stays small
+        self.tabifyDockWidget(docks[2], docks[4])  # and the compared structures
         docks[3].raise_()
         self._create_actions()
         self._create_menus(docks)

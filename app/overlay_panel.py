@@ -42,13 +42,15 @@ class ComparisonPanel(QWidget):
         self.add_button.setToolTip("Read structures, superpose their longest chain on the edited chain and show them")
         self.add_button.clicked.connect(self.add_dialog)
         self.level_text = QLabel()
-        self.level_text.setWordWrap(True)
+        self.level_text.setToolTip("Every chain has its own top level log₂ N: each compared chain is shown as many "
+                                   "levels below its top as the edited segment, so all keep the same fraction of "
+                                   "their detail. They are superposed on the edited chain's Cα.")
         self.table = QTableWidget(0, len(COLUMNS))
         self.table.setHorizontalHeaderLabels(COLUMNS)
         self.table.verticalHeader().hide()
         self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         self.table.horizontalHeader().setStretchLastSection(True)
-        self.table.setMinimumHeight(120)
+        self.table.setMinimumHeight(0)  # the dock shares its place with others: the window stays small
         row = QHBoxLayout()
         row.addWidget(self.add_button)
         row.addStretch(1)
@@ -84,6 +86,7 @@ class ComparisonPanel(QWidget):
 
     def _fill(self) -> None:
         items = self.comparison.items
+        self.table.setRowCount(0)  # drops the widgets of the old rows
         self.table.setRowCount(len(items))
         for row, item in enumerate(items):
             swatch = QPixmap(14, 14)
@@ -107,6 +110,7 @@ class ComparisonPanel(QWidget):
             remove.clicked.connect(lambda _=False, row=row: self.comparison.remove(row))
             for column, widget in enumerate((visible, chain, rms, remove)):
                 self.table.setCellWidget(row, column, widget)
+        self.table.updateGeometries()  # place the new widgets in their cells now, not at the next event
         self._update_level()
 
     def _chain_chosen(self, row: int, chain: str) -> None:
@@ -122,8 +126,4 @@ class ComparisonPanel(QWidget):
             self.level_text.setText("Open a structure first.")
             return
         depth = self.comparison.depth
-        self.level_text.setText(
-            f"Superposed on the edited chain; each shown {depth:.2f} levels below its own log₂ N, "
-            f"as the edited segment ({document.shown_level():.2f} of {document.max_level:.2f}): "
-            "the same fraction of detail."
-        )
+        self.level_text.setText(f"Each at {depth:.2f} levels below its own log₂ N (same depth as the edited segment)")
