@@ -193,6 +193,11 @@ class Document(QObject):
         probe = self._model.move_point(self.segment, self.shown_level(), index, np.array([1.0, 0.0, 0.0]))
         self._set_pick(Pick(index, probe.residues))
 
+    @property
+    def dragging(self) -> bool:
+        """Whether a drag's edit is being previewed (not yet an undo step)."""
+        return self._preview is not None
+
     def preview_move(self, index: int, displacement: np.ndarray) -> None:
         """Show control point ``index`` moved by ``displacement`` (Å) from where the drag began."""
         self._preview_edit(lambda: self._model.move_point(self.segment, self.shown_level(), index, displacement))

@@ -53,7 +53,8 @@ class ValidationMarkers(QObject):
         self.refresh()
 
     def refresh(self) -> None:
-        """Show the markers of the current report (no render: the scene renders after each change)."""
+        """Show the markers of the current report; render only after a deferred check (the
+        scene renders after each change)."""
         report = self.validation.report
         if report is None:
             return
@@ -73,7 +74,10 @@ class ValidationMarkers(QObject):
             self.mesh.Modified()
         else:
             self.mesh.shallow_copy(_points(positions, colours))
-        self.scene.actors[NAME].SetVisibility(Layer.VALIDATION in self.scene.layers)
+        visible = Layer.VALIDATION in self.scene.layers
+        self.scene.actors[NAME].SetVisibility(visible)
+        if visible and self.validation.late:
+            self.scene.plotter.render()
 
 
 def _points(positions: np.ndarray, colours: np.ndarray) -> pv.PolyData:

@@ -9,6 +9,7 @@ import pytest
 from pytestqt.qtbot import QtBot
 from test_window import _display, _mouse_drag, _window
 
+from app import live_validation
 from app.main_window import MainWindow
 from app.scene import Layer
 from app.validation_markers import MARKED, severity_colours
@@ -99,7 +100,7 @@ def test_regularize_while_dragging_shows_regular_previews(window: MainWindow) ->
     assert np.array_equal(document.model.coords, original)
 
 
-def test_panel_counts_follow_the_model_during_and_after_drags(window: MainWindow) -> None:
+def test_panel_counts_follow_the_model_during_and_after_drags(window: MainWindow, qtbot: QtBot) -> None:
     window.validation_panel.on_release.setChecked(False)
     _assert_panel_matches_the_model(window)
     start = _press_point(window)
@@ -109,6 +110,7 @@ def test_panel_counts_follow_the_model_during_and_after_drags(window: MainWindow
     for k in (1, 2, 3):  # 64 of 76 residues move: each preview is checked in full
         interactor.SetEventInformation(start[0] + OFFSET[0] * k // 3, start[1] + OFFSET[1] * k // 3)
         interactor.InvokeEvent("MouseMoveEvent")
+        qtbot.waitUntil(lambda: not window.validation.pending, timeout=2000)  # checked at most every 100 ms
         _assert_panel_matches_the_model(window)
     interactor.InvokeEvent("LeftButtonReleaseEvent")
     assert sum(window.validation.report.counts.values()) > 10
@@ -177,3 +179,21 @@ def test_severity_colours_run_from_yellow_to_red() -> None:
     colours = severity_colours([1.0, 2.5, 4.0, 40.0])
     assert tuple(colours[0]) == (250, 205, 40) and tuple(colours[2]) == tuple(colours[3]) == (215, 25, 28)
     assert colours[0, 1] > colours[1, 1] > colours[2, 1]
+
+
+def test_checks_during_a_drag_wait_for_the_interval_and_the_release_catches_up(
+    window: MainWindow, monkeypatch
+) -> None:
+    monkeypatch.setattr(live_validation, "DRAG_INTERVAL_MS", 60_000)  # no deferred check fires in this test
+    window.validation_panel.on_release.setChecked(False)
+    start = _press_point(window)
+    interactor = window.plotter.iren.interactor
+    interactor.SetEventInformation(*start)
+    interactor.InvokeEvent("LeftButtonPressEvent")
+    for k in (1, 2, 3):
+        interactor.SetEventInformation(start[0] + OFFSET[0] * k // 3, start[1] + OFFSET[1] * k // 3)
+        interactor.InvokeEvent("MouseMoveEvent")
+        assert window.validation.pending  # the check on opening the file was less than a minute ago
+    interactor.InvokeEvent("LeftButtonReleaseEvent")
+    assert not window.validation.pending
+    _assert_panel_matches_the_model(window)
