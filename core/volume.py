@@ -31,6 +31,10 @@ class MapError(ValueError):
     """A file that cannot be read as a density map."""
 
 
+UNKNOWN_B = 20.0
+"""B-factor (Å²) used for atoms whose file gives none (0): a typical value for a protein."""
+
+
 @dataclass(frozen=True, eq=False)
 class DensityMap:
     """Values on a grid.
@@ -107,7 +111,8 @@ def read_map(path: str | os.PathLike[str]) -> DensityMap:
 def model_density(atoms: AtomTable, *, spacing: float = 0.75, resolution: float = 3.0, margin: float = 5.0) -> DensityMap:
     """Electron density of the non-water atoms of a model (gemmi's DensityCalculatorX:
     IT92 form factors, each atom blurred by its B-factor), in a box ``margin`` Å wider
-    than the atoms, at a ``resolution`` (Å) and grid ``spacing`` (Å)."""
+    than the atoms, at a ``resolution`` (Å) and grid ``spacing`` (Å). Atoms without a
+    B-factor (0, as in NMR models) get :data:`UNKNOWN_B`."""
     keep = atoms.category != "water"
     if not keep.any():
         raise ValueError(f"{atoms.entry_id}: no atoms to compute a density from")
@@ -123,7 +128,7 @@ def model_density(atoms: AtomTable, *, spacing: float = 0.75, resolution: float 
         atom = gemmi.Atom()
         atom.pos = gemmi.Position(*xyz)
         atom.element = gemmi.Element(element)
-        atom.b_iso = b
+        atom.b_iso = b if b > 0 else UNKNOWN_B  # a zero B gives NaN densities
         atom.occ = occupancy
         residue.add_atom(atom)
     chain = gemmi.Chain("A")

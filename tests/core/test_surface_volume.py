@@ -74,3 +74,10 @@ def test_bad_map_files(tmp_path: Path) -> None:
     (tmp_path / "junk.map").write_bytes(b"not a map at all" * 100)
     with pytest.raises(MapError, match="not a readable"):
         read_map(tmp_path / "junk.map")
+
+
+def test_models_without_b_factors_give_a_finite_density() -> None:
+    atoms = read_atoms(DATA / "1L2Y.pdb.gz")  # NMR: every B-factor is 0, hydrogens included
+    assert np.all(atoms.b_factor == 0)
+    values = model_density(atoms).values
+    assert np.all(np.isfinite(values)) and values.max() > 1.0
