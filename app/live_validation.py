@@ -8,9 +8,10 @@ than half of the residues is checked in full. Every atom outside a change is whe
 when the report described it, so the folded report is the report of the current
 coordinates. Views follow :attr:`LiveValidation.updated`.
 
-During a drag the report is brought up to date at most every :data:`DRAG_INTERVAL_MS`
-(the residues moved meanwhile are checked together), so a drag step does not pay for a
-check; every other change, the end of a drag included, is checked at once.
+During a drag the report is brought up to date from the event loop, at most every
+:data:`DRAG_INTERVAL_MS` (the residues moved meanwhile are checked together), so a drag
+step does not pay for a check; every other change, the end of a drag included, is
+checked at once.
 """
 
 from __future__ import annotations
@@ -71,10 +72,10 @@ class LiveValidation(QObject):
     def _check_change(self, change: Change) -> None:
         residues = self.document.structure.segments[change.segment].residue_index[change.residues]
         self._pending = residues if self._pending is None else np.union1d(self._pending, residues)
-        wait = DRAG_INTERVAL_MS - 1e3 * (time.perf_counter() - self._finished)
-        if self.document.dragging and wait > 0:
+        if self.document.dragging:  # checked in an event-loop turn of its own, not in the drag step
             if not self._timer.isActive():
-                self._timer.start(int(wait) + 1)
+                wait = DRAG_INTERVAL_MS - 1e3 * (time.perf_counter() - self._finished)
+                self._timer.start(max(0, int(wait) + 1))
             return
         self._check_pending()
 
