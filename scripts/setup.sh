@@ -8,12 +8,13 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 # Run-time libraries of the PySide6 and VTK wheels that a minimal Debian 12 lacks
 # (found with ldd on Qt's xcb platform plugin and QtGui, and QT_DEBUG_PLUGINS=1), Mesa
-# for software OpenGL, and Xvfb for machines without a display.
+# for software OpenGL, libXcursor (which VTK loads for its mouse cursors), and Xvfb for
+# machines without a display.
 debian_packages=(
   xvfb xauth
   libgl1 libglx-mesa0 libgl1-mesa-dri libegl1
   libglib2.0-0 libdbus-1-3 libfontconfig1 libfreetype6
-  libx11-6 libx11-xcb1 libxkbcommon0 libxkbcommon-x11-0
+  libx11-6 libx11-xcb1 libxcursor1 libxkbcommon0 libxkbcommon-x11-0
   libxcb1 libxcb-cursor0 libxcb-glx0 libxcb-icccm4 libxcb-image0 libxcb-keysyms1
   libxcb-randr0 libxcb-render0 libxcb-render-util0 libxcb-shape0 libxcb-shm0
   libxcb-sync1 libxcb-util1 libxcb-xfixes0 libxcb-xkb1
