@@ -62,6 +62,10 @@ class LiveValidation(QObject):
         """Whether moved residues wait for their (deferred) check."""
         return self._pending is not None
 
+    def check_now(self) -> None:
+        """Run a check that waits for the drag interval at once (if there is one)."""
+        self._check_pending()
+
     def _check_all(self, late: bool = False) -> None:
         self._timer.stop()
         self._pending = None

@@ -84,21 +84,29 @@ def drag(window: MainWindow, level: float) -> Clock:
     return clock
 
 
+def open_window(app: QApplication, name: str) -> MainWindow:
+    """A shown window on test entry ``name``, every layer that follows an edit switched on,
+    with its longest segment chosen."""
+    document = Document()
+    document.open(DATA / name)
+    window = MainWindow(document)
+    for layer in (Layer.CA_TRACE, Layer.ATOMS):
+        window.scene.set_layer(layer, True)
+    window.show()
+    app.processEvents()
+    document.set_segment(max(range(len(document.paths)), key=lambda g: len(document.structure.segments[g])))
+    return window
+
+
 def main() -> None:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     print(f"Editor steps in ms (median and worst of {MOVES} steps; render = one software-OpenGL frame)")
     print(f"  {'':<34}{'update':>9}{'worst':>9}{'render':>11}{'worst':>9}")
     for name, label in STRUCTURES:
-        document = Document()
-        document.open(DATA / name)
-        window = MainWindow(document)
-        for layer in (Layer.CA_TRACE, Layer.ATOMS):  # every layer that follows an edit is on
-            window.scene.set_layer(layer, True)
-        window.show()
-        app.processEvents()
+        window = open_window(app, name)
+        document = window.document
         residues = document.structure.n_residues
-        segment = max(range(len(document.paths)), key=lambda g: len(document.structure.segments[g]))
-        document.set_segment(segment)
+        segment = document.segment
         print(f"{name} ({label}); edited segment of {len(document.structure.segments[segment])} residues, "
               f"{residues} residues in all, tube of {window.scene.meshes['tube'].n_points} vertices")
         top = document.max_level

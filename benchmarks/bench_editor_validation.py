@@ -3,7 +3,8 @@
 Run with ``python benchmarks/bench_editor_validation.py`` (under ``xvfb-run`` without a
 display). Drag steps go through the VTK interactor as in ``bench_editor.py`` (render
 excluded), now with the live validation (a local check of the moved residues folded into
-the last report), the validation markers and the dock: without regularization, then with
+the last report, run between mouse events and timed apart as "check"), the validation
+markers and the dock: without regularization, then with
 "regularize while dragging". Also timed: the full check when a file opens, the local check
 alone, and the release of a drag with "regularize on release" (the regularization and the
 updates of the one undo step).
@@ -13,15 +14,12 @@ from __future__ import annotations
 
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
-from bench_editor import DATA, MOVES, STRUCTURES, Clock, display
+from bench_editor import MOVES, STRUCTURES, Clock, display, open_window
 from PySide6.QtWidgets import QApplication
 
-from app.document import Document
 from app.main_window import MainWindow
-from app.scene import Layer
 
 
 def drag(window: MainWindow, level: float, *, while_dragging: bool) -> tuple[Clock, list[float], float]:
@@ -40,6 +38,7 @@ def drag(window: MainWindow, level: float, *, while_dragging: bool) -> tuple[Clo
     for k in range(1, MOVES + 1):
         interactor.SetEventInformation(start[0] + 3 * k, start[1] + 2 * k)
         clock.step(lambda: interactor.InvokeEvent("MouseMoveEvent"))
+        window.validation.check_now()  # the check the event loop runs between mouse events
         checks.append(window.validation.elapsed_ms)
     window.plotter.render = lambda: None
     begin = time.perf_counter()
@@ -56,15 +55,8 @@ def main() -> None:
     print(f"Editor steps with validation in ms (median and worst of {MOVES} steps; render excluded)")
     print(f"  {'':<44}{'update':>9}{'worst':>9}{'check':>9}{'release':>9}")
     for name, label in STRUCTURES:
-        document = Document()
-        document.open(DATA / name)
-        window = MainWindow(document)
-        for layer in (Layer.CA_TRACE, Layer.ATOMS):
-            window.scene.set_layer(layer, True)
-        window.show()
-        app.processEvents()
-        segment = max(range(len(document.paths)), key=lambda g: len(document.structure.segments[g]))
-        document.set_segment(segment)
+        window = open_window(app, name)
+        document = window.document
         begin = time.perf_counter()
         window.validation._check_all()
         print(f"{name} ({label}); full check {1e3 * (time.perf_counter() - begin):.1f} ms "

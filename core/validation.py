@@ -289,7 +289,6 @@ class Topology:
 def topology(structure: Structure) -> Topology:
     """The validation set-up of ``structure`` (cached: structures are immutable)."""
     atoms = structure.atoms
-    n_atoms = len(atoms)
     backbone = _backbone_rows(structure)
     segment_of = np.concatenate([np.full(len(s), k) for k, s in enumerate(structure.segments)])
     first = np.flatnonzero(segment_of[:-1] == segment_of[1:])
