@@ -22,7 +22,7 @@ from app.commands import EditCommand
 from app.curves import LevelCurve, SegmentPath
 from app.molecule import ca_rows
 from core.model import Edit, EditableModel
-from core.regularize import FLANK, regularized, relax
+from core.regularize import FLANK, regularize_region, regularized
 from core.ribbon import RibbonKind
 from core.structure import Structure, read_structure
 
@@ -232,7 +232,7 @@ class Document(QObject):
         """Regularize ``residues`` (indices within the current segment) and up to FLANK neighbours
         on each side as one undo step: ideal junctions, on the current curve, and no clash
         that the structure as read did not have."""
-        edit = _region_edit(self._model, self.segment, np.asarray(residues, dtype=np.int64))
+        edit = regularize_region(self._model, self.segment, residues, flank=FLANK)
         if not np.array_equal(edit.old_coords, edit.new_coords):
             self.undo_stack.push(EditCommand(self, edit, f"Regularize {self.residue_range(edit.residues)}"))
 
@@ -305,20 +305,6 @@ class Document(QObject):
             return
         self.pick = pick
         self.picked.emit()
-
-
-def _region_edit(model: EditableModel, segment: int, residues: np.ndarray) -> Edit:
-    """The edit that relaxes ``residues`` of ``segment`` and their flanks (see :func:`core.regularize.relax`),
-    tethered to the current curve; pairs may keep the overlap they had in the structure as read."""
-    n_residues = len(model.segments[segment])
-    spread = (residues[:, None] + np.arange(-FLANK, FLANK + 1)).ravel()
-    free = np.unique(spread[(spread >= 0) & (spread < n_residues)])
-    ribbon = model.ribbons[segment]
-    u = ribbon.residue_u[free]
-    result = relax(model.structure, model.coords, model.segments[segment].residue_index[free],
-                   ribbon.space.evaluate(ribbon.points, u), ribbon.space.evaluate(ribbon.points, u, 1),
-                   model.structure.coords)
-    return Edit(segment, ribbon.points, ribbon.points, free, result.rows, model.coords[result.rows], result.coords)
 
 
 def _union(a: np.ndarray, b: np.ndarray, size: int) -> np.ndarray:

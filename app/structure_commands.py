@@ -165,7 +165,8 @@ def edit_arguments(parser: argparse.ArgumentParser) -> None:
                         help="output file; PDB or mmCIF by the extension (.pdb, .cif, optionally .gz)")
     parser.add_argument("--overwrite", action="store_true", help="replace OUT if it exists (even the input file)")
     parser.add_argument("--regularize", action="store_true",
-                        help="then move the residues again (rigidly) to ideal peptide junctions without new clashes")
+                        help="then move the residues again (rigid, turning their carbonyls) to ideal peptide "
+                             "junctions without new clashes or Ramachandran outliers")
 
 
 def run_edit(args: argparse.Namespace) -> int:
@@ -198,7 +199,8 @@ def run_edit(args: argparse.Namespace) -> int:
         flagged = [validate(structure, coords, residues=region).counts for coords in (before, model.coords)]
         print("regularized: " + ", ".join(
             f"{flagged[0][kind]} -> {flagged[1][kind]} {name}" for kind, name in
-            (("peptide_bond", "bad peptide bonds"), ("ca_ca", "bad Cα–Cα"), ("clash", "clashes"))))
+            (("peptide_bond", "bad peptide bonds"), ("ca_ca", "bad Cα–Cα"), ("clash", "clashes"),
+             ("ramachandran", "Ramachandran outliers"))))
     return 0
 
 

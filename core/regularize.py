@@ -2,28 +2,31 @@
 
 Carson's edits move each residue as a rigid body with its curve frame and apply no other
 constraint, so peptide bonds stretch and atoms run into each other. Here the residues an
-edit moved (plus ``flank`` neighbours on each side) are moved again, each still as a
-rigid body, to the least-squares best compromise (Levenberg–Marquardt on the rigid-body
-motions, analytic Jacobian, sparse normal equations) of:
+edit moved (plus ``flank`` neighbours on each side) are moved again, each as a rigid body
+whose carbonyl O may turn about the Cα–C bond (ψ), to the least-squares best compromise
+(Levenberg–Marquardt, analytic Jacobian, sparse normal equations) of:
 
 - **junctions** (σ = :data:`JUNCTION_SIGMA`): each residue carries the ideal planar
   peptide that follows it, built from its own Cα, C and O with Engh & Huber values
   (C–N, Cα–C–N, C–N–Cα; ω = 180°, or 0° where the input peptide is cis); the next
-  residue's N and Cα must sit on that peptide's N and Cα. With rigid residues this fixes
-  the bond, both angles, ω and the carbonyl planarity and leaves φ free; ψ and the side
-  chains keep the conformation they had. Cα-only junctions keep their Cα–Cα distance.
+  residue's N and Cα must sit on that peptide's N and Cα. This fixes the bond, both
+  angles, ω and the carbonyl planarity and leaves φ and ψ free. Cα-only junctions keep
+  their Cα–Cα distance.
 - **the tether to the edited curve**: each residue's curve point C^r stays on the curve
-  (σ = :data:`TETHER_SIGMA` across it, :data:`SLIDE_SIGMA` along it), and its N, Cα and C
-  stay near where the edit put them (σ = :data:`ORIENTATION_SIGMA`).
+  (σ = :data:`TETHER_SIGMA` across it, :data:`SLIDE_SIGMA` along it), and its N, Cα, C
+  and O stay near where the edit put them (σ = :data:`ORIENTATION_SIGMA`).
 - **clashes** (σ = :data:`CLASH_SIGMA`, one-sided and smooth): heavy-atom pairs (those
-  :mod:`core.validation` checks) are pushed apart until they overlap by at most
-  :data:`CLASH_TARGET`, or by what they overlapped before the edit if that was more.
+  :mod:`core.validation` checks, and a turned O against its own side chain) are pushed
+  apart until they overlap by at most :data:`CLASH_TARGET`, or by what they overlapped
+  before the edit if that was more.
 
-Why rigid residues: the editor moves residues as rigid bodies already; 6 parameters per
-residue keep every bond inside a residue exact (side chains, rotamers, alternate
-conformers, hydrogens), and the normal equations are sparse and nearly banded (junctions
-couple chain neighbours), solved by preconditioned conjugate gradients in O(m). The price is that ψ cannot change, so the chain bends at
-φ only; tight bends that need ψ are met less closely by the tether.
+Why rigid residues with a turning carbonyl: the editor moves residues as rigid bodies
+already, and 7 parameters per residue keep every bond length and angle inside a residue
+exact (side chains, rotamers, alternate conformers, hydrogens) while the backbone keeps
+both of its torsions, φ (between residues) and ψ (the carbonyl turn), to close the
+junctions and bend around clashes. Only the backbone can give: side chains stay as they
+were. The normal equations are sparse and nearly banded (junctions couple chain
+neighbours, clashes mostly residues a few apart) and are factored in O(m).
 Why fixed outer neighbours: the edit's B-spline change fades to zero at the ends of its
 support, so the rest of the chain is left exactly as it was (locality, nothing to redraw
 outside the edit), and the ``flank`` residues just inside absorb the strain at the two
@@ -39,26 +42,36 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import linalg, sparse
+from scipy import sparse
+from scipy.sparse.linalg import splu
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from .model import Edit, EditableModel
 from .structure import Structure
 from .validation import (
-    C_N, C_N_CA, C_N_CA_PRO, C_N_PRO, CA_C_N, CA_C_N_PRO, CA_CA_CIS, CA_CA_TRANS, distance, topology,
+    C_N, C_N_CA, C_N_CA_PRO, C_N_PRO, CA_C_N, CA_C_N_PRO, CA_CA_CIS, CA_CA_TRANS, CLASH_OVERLAP, OUTLIER,
+    dihedral, distance, nearest_allowed, ramachandran_region, topology,
 )  # fmt: skip
 
 FLANK = 3
 """Residues on each side of an edit that may move too (inside the segment)."""
 JUNCTION_SIGMA = 0.01
 """Å; the scale of junction residuals (validation tolerates 0.05 Å on the C–N bond)."""
+JUNCTION_SLACK = 0.04
+"""Å; the solver tries harder while a junction point is off by more than this."""
 TETHER_SIGMA = 0.2
 """Å; how far a residue's C^r may leave the edited curve, across it."""
 SLIDE_SIGMA = 1.0
 """Å; how far C^r may slide along the curve."""
-ORIENTATION_SIGMA = 1.0
-"""Å; a weak hold of N, Cα and C where the edit put them (the residue's orientation)."""
+HOLD_SIGMA = 1.0
+"""Å; a weak hold of each Cα where the edit put it."""
+TORSION_SIGMA = 15.0
+"""Degrees; how far φ and ψ may turn from where the edit put them (which keeps residues
+in their Ramachandran regions)."""
+RAMACHANDRAN_SIGMA = 0.5
+"""Degrees; the scale of a φ's or ψ's distance from the nearest allowed Ramachandran
+region (residues that were outliers before the edit are left as they are)."""
 CLASH_SIGMA = 0.01
 """Å; the scale of clash residuals."""
 CLASH_TARGET = 0.3
@@ -70,20 +83,25 @@ CLASH_MARGIN = 0.5
 """Å: pairs this much short of clashing enter the least squares."""
 SURROUNDINGS = 4.0
 """Å: the fixed atoms near the free ones are found once, for moves up to this far."""
+SKIN = 2.0
+"""Å: the clash candidates are the pairs within CLASH_MARGIN + SKIN of clashing, listed
+again once a free atom has moved SKIN / 2 (a Verlet list)."""
 DAMPING = 1e-2
 """Initial Levenberg–Marquardt damping, relative to the diagonal."""
-TOLERANCE = 3e-2
-"""Stop when a step is predicted to lower the objective by less than this fraction (a
-tenth of it while a junction or a clash is still out of tolerance)."""
+TOLERANCE = 0.1
+"""Stop when no junction, residue or clash would be flagged and a step is predicted to
+lower the objective by less than this fraction."""
+STALL = 3e-3
+"""Stop anyway when a step is predicted to lower the objective by less than this fraction."""
 MAX_ITERATIONS = 40
-"""Levenberg–Marquardt steps at most (typically 8–20 are taken)."""
-BAND_BLOCKS = 4
-"""Width, in 6 x 6 blocks below the diagonal, of the band that preconditions the solve."""
-CG_STEPS = 50
-"""Conjugate-gradient steps at most per solve."""
-CG_TOLERANCE = 1e-6
-"""Stop the conjugate gradients when r·M⁻¹r has fallen by this factor (an inexact step is
-as good to Levenberg–Marquardt)."""
+"""Levenberg–Marquardt steps at most (typically 6–15 are taken)."""
+STEP_SHIFT = 1.0
+"""Å; no step shifts a body farther, ..."""
+STEP_TURN = 20.0
+"""Degrees; ... or turns it or its carbonyl farther (the whole step is scaled down): the
+clash and Ramachandran terms act only once crossed, so a long step could jump across."""
+PARAMETERS = 7
+"""Per body: a shift, a rotation vector and the turn ψ of the carbonyl about Cα–C."""
 
 
 @dataclass(frozen=True)
@@ -125,9 +143,13 @@ def regularized(model: EditableModel, edit: Edit, *, flank: int = FLANK) -> Edit
     return Edit(edit.segment, edit.old_points, edit.new_points, free, result.rows, before[result.rows], result.coords)
 
 
-def regularize_region(model: EditableModel, segment: int, residues: object, *, flank: int = 0) -> Edit:
-    """The edit that regularizes ``residues`` (indices within ``segment``) of the current
-    model, tethered to its current curve (control points unchanged)."""
+def regularize_region(
+    model: EditableModel, segment: int, residues: object, *, flank: int = 0, reference: np.ndarray | None = None
+) -> Edit:
+    """The edit that regularizes ``residues`` (indices within ``segment``) and up to
+    ``flank`` neighbours on each side of the current model, tethered to its current curve
+    (control points unchanged). Pairs may keep the overlap they had in ``reference``
+    (default: the structure as read)."""
     ribbon = model.ribbons[segment]
     n_residues = len(model.segments[segment])
     residues = np.asarray(residues, dtype=np.int64)
@@ -137,7 +159,9 @@ def regularize_region(model: EditableModel, segment: int, residues: object, *, f
     u = ribbon.residue_u[free]
     anchors = ribbon.space.evaluate(ribbon.points, u)
     tangents = ribbon.space.evaluate(ribbon.points, u, 1)
-    result = relax(model.structure, model.coords, model.segments[segment].residue_index[free], anchors, tangents)
+    reference = model.structure.coords if reference is None else reference
+    result = relax(model.structure, model.coords, model.segments[segment].residue_index[free], anchors, tangents,
+                   reference)
     return Edit(segment, ribbon.points, ribbon.points, free, result.rows, model.coords[result.rows], result.coords)
 
 
@@ -149,7 +173,8 @@ def relax(
     tangents: np.ndarray,
     reference: np.ndarray | None = None,
 ) -> Relaxation:
-    """Move ``residues`` as rigid bodies to ideal junctions, on the curve, without new clashes.
+    """Move ``residues`` (rigid, their carbonyls turning about Cα–C) to ideal junctions,
+    on the curve, without new clashes.
 
     Parameters
     ----------
@@ -189,133 +214,234 @@ def _with_flanks(residues: np.ndarray, flank: int, n_residues: int) -> np.ndarra
 # ---------------------------------------------------------------------------- solver
 
 
-class _Problem:
-    """The free residues as rigid bodies and the terms of the least squares.
+@dataclass(frozen=True)
+class _State:
+    """Where the bodies are: body ``k`` turned by ``rotation[k]`` about its start Cα and
+    moved by ``shift[k]``, its carbonyl turned by ``psi[k]`` about the Cα–C bond first."""
 
-    Every point is attached to a body (or to nothing: fixed) and moves as
-    ``x = c + t + R (x0 - c)``, ``c`` the body's Cα at the start. A vector term weighs the
+    rotation: np.ndarray
+    shift: np.ndarray
+    psi: np.ndarray
+
+    @classmethod
+    def start(cls, n_bodies: int) -> _State:
+        return cls(np.broadcast_to(np.eye(3), (n_bodies, 3, 3)).copy(), np.zeros((n_bodies, 3)), np.zeros(n_bodies))
+
+    def moved(self, step: np.ndarray) -> _State:
+        """The state after ``step``: (δt, δω, δψ) of every body, flattened."""
+        step = step.reshape(-1, PARAMETERS)
+        turn = Rotation.from_rotvec(step[:, 3:6]).as_matrix()
+        return _State(np.einsum("bij,bjk->bik", turn, self.rotation), self.shift + step[:, :3], self.psi + step[:, 6])
+
+
+class _Problem:
+    """The free residues as bodies and the terms of the least squares.
+
+    A point ``y`` of body ``k`` (residue ``residues[k]``) moves to ``c + t + R (y' - c)``,
+    ``c`` the body's start Cα, where ``y' = y`` but for the carbonyl (O, OXT and the ideal
+    next N and Cα built on them), which is first turned by ψ about the start Cα–C axis.
+    Points of the terms belong to a body or to none (-1: fixed). A vector term weighs the
     difference of two points with a 3 x 3 matrix (one residual per row); distance terms
-    ask two points to be ``d0`` apart; clash terms two atoms to be at least ``d_min`` apart.
+    ask two points to be ``d0`` apart; Ramachandran terms a φ or ψ to be allowed; clash
+    terms two atoms to be at least ``d_min`` apart. Residuals come in that order.
     """
 
     def __init__(self, structure: Structure, coords: np.ndarray, residues: np.ndarray,
                  anchors: np.ndarray, tangents: np.ndarray, reference: np.ndarray) -> None:
         self.top = top = topology(structure)
-        self.coords = coords
         self.reference = reference
-        body_of = np.full(len(top.backbone), -1)
-        body_of[residues] = np.arange(len(residues))
-        self.body_of_atom = np.where(structure.atom_residue >= 0, body_of[structure.atom_residue.clip(min=0)], -1)
-        self.rows = np.flatnonzero(self.body_of_atom >= 0)
+        self.n_bodies = n = len(residues)
+        bb = top.backbone
+        body_of = np.full(len(bb), -1)
+        body_of[residues] = np.arange(n)
+        self.atom_body = np.where(structure.atom_residue >= 0, body_of[structure.atom_residue.clip(min=0)], -1)
+        self.rows = np.flatnonzero(self.atom_body >= 0)
+        self.centre = coords[bb[residues, 1]]
+        rotor = bb[residues, 2] >= 0
+        self.pivot = np.where(rotor[:, None], coords[bb[residues, 2]], self.centre)
+        self.axis = np.zeros((n, 3))
+        self.axis[rotor] = _unit(self.pivot[rotor] - self.centre[rotor])
+        carbonyl = self.rows[np.isin(structure.atoms.name[self.rows], ("O", "OXT"))]
+        self.atom_turns = np.zeros(len(coords), dtype=bool)
+        self.atom_turns[carbonyl[rotor[self.atom_body[carbonyl]]]] = True
+        self.current = coords.copy()
         self.free_atoms = self.rows[top.checked[self.rows]]
         self.surroundings: np.ndarray | None = None
-        self.centres = coords[top.backbone[residues, 1]]
-        self.n_bodies = n = len(residues)
-        points, owners, vector_terms = [], [], []
+        self.listed_at: np.ndarray | None = None
+        points, owners, turns, vector_terms = [], [], [], []
 
-        def add(xyz: np.ndarray, owner: np.ndarray) -> np.ndarray:
+        def add(xyz: np.ndarray, owner: np.ndarray, turn: bool | np.ndarray) -> np.ndarray:
             start = sum(len(p) for p in points)
             points.append(xyz)
             owners.append(owner)
+            turns.append(np.broadcast_to(turn, len(xyz)) & (owner >= 0) & rotor[owner])
             return np.arange(start, start + len(xyz))
 
-        def coincide(xyz_a: np.ndarray, owner_a: np.ndarray, xyz_b: np.ndarray, owner_b: np.ndarray,
-                     weights: np.ndarray) -> None:
-            weights = np.broadcast_to(weights, (len(xyz_a), 3, 3))
-            vector_terms.append((add(xyz_a, owner_a), add(xyz_b, owner_b), weights))
+        def coincide(a: tuple, b: tuple, weights: np.ndarray) -> None:
+            vector_terms.append((add(*a), add(*b), np.broadcast_to(weights, (len(a[0]), 3, 3))))
 
         # junctions with a free residue: the next N and Cα on this residue's ideal peptide
         k = np.flatnonzero((body_of[top.first] >= 0) | (body_of[top.second] >= 0))
-        first, second, bb = top.first[k], top.second[k], top.backbone
+        first, second = top.first[k], top.second[k]
         full = (bb[first, 1:4] >= 0).all(axis=1) & (bb[second, :2] >= 0).all(axis=1)
         f, s = first[full], second[full]
         ideal_n, ideal_ca = _ideal_next(coords, bb[f], bb[s], top.cis[k[full]], top.proline[k[full]])
         stiff = np.eye(3) / JUNCTION_SIGMA
-        coincide(ideal_n, body_of[f], coords[bb[s, 0]], body_of[s], stiff)
-        coincide(ideal_ca, body_of[f], coords[bb[s, 1]], body_of[s], stiff)
+        coincide((ideal_n, body_of[f], True), (coords[bb[s, 0]], body_of[s], False), stiff)
+        coincide((ideal_ca, body_of[f], True), (coords[bb[s, 1]], body_of[s], False), stiff)
         self.n_junction_rows = 6 * len(f)  # the first rows: N and Cα of the next residue, 3 each
         f, s = first[~full], second[~full]  # Cα only: keep the Cα–Cα distance
-        self.distance_a = add(coords[bb[f, 1]], body_of[f])
-        self.distance_b = add(coords[bb[s, 1]], body_of[s])
+        self.distance_a = add(coords[bb[f, 1]], body_of[f], False)
+        self.distance_b = add(coords[bb[s, 1]], body_of[s], False)
         self.distance_d0 = np.where(top.cis[k[~full]], CA_CA_CIS, CA_CA_TRANS)
-        # the tether: C^r on the curve (free to slide along it), N, Cα, C near where they were
-        along = tangents / np.linalg.norm(tangents, axis=1, keepdims=True)
-        across = _normal_planes(along)
-        weights = np.concatenate([across / TETHER_SIGMA, along[:, None] / SLIDE_SIGMA], axis=1)
-        coincide(anchors, np.full(n, -1), anchors, np.arange(n), weights)
-        held = bb[residues, :3]
-        body, slot = np.nonzero(held >= 0)
-        targets = coords[held[body, slot]]
-        coincide(targets, np.full(len(body), -1), targets, body, np.eye(3) / ORIENTATION_SIGMA)
+        self._ramachandran_terms(residues, body_of, reference)
+        # the tether: C^r on the curve (free to slide along it), Cα near where it was
+        along = _unit(tangents)
+        weights = np.concatenate([_normal_planes(along) / TETHER_SIGMA, along[:, None] / SLIDE_SIGMA], axis=1)
+        coincide((anchors, np.full(n, -1), False), (anchors, np.arange(n), False), weights)
+        coincide((self.centre, np.full(n, -1), False), (self.centre, np.arange(n), False), np.eye(3) / HOLD_SIGMA)
+        # torsions held loosely (each a turn of a point about a bond, 2 r sin(angle / 2) long):
+        # ψ, each O turned against the same O unturned; φ, each C on its residue against the
+        # same C on the carbonyl before it
+        body = np.flatnonzero(rotor & (bb[residues, 3] >= 0))
+        oxygen = coords[bb[residues[body], 3]]
+        radius = _off_axis(oxygen, self.pivot[body], self.axis[body])
+        coincide((oxygen, body, False), (oxygen, body, True), _torsion_weights(radius))
+        f, s = first[full], second[full]
+        carbon = coords[bb[s, 2]]
+        ok = bb[s, 2] >= 0
+        f, s, carbon = f[ok], s[ok], carbon[ok]
+        radius = _off_axis(carbon, coords[bb[s, 1]], _unit(coords[bb[s, 1]] - coords[bb[s, 0]]))
+        coincide((carbon, body_of[f], True), (carbon, body_of[s], False), _torsion_weights(radius))
+        vector_a, vector_b, weights = (np.concatenate(t) for t in zip(*vector_terms))
+        self.vector_a, self.vector_b, self.vector_weights = vector_a, vector_b, weights
+        self.n_vector_rows = 3 * len(vector_a)
+        # every point that may move: the points of the terms, then the atoms of the free residues
+        self.n_points = sum(len(p) for p in points)
+        self.start = np.concatenate([*points, coords[self.rows]])
+        owner = np.concatenate([*owners, self.atom_body[self.rows]])
+        carbonyl = np.concatenate([*turns, self.atom_turns[self.rows]])
+        self.moving = np.flatnonzero(owner >= 0)
+        self.moving_body = owner[self.moving]
+        self.turning = np.flatnonzero(carbonyl)
+        self.turning_body = owner[self.turning]
+        # the two sides of the vector rows (3 per term) and distance terms: points, bodies, carbonyl or not
+        side_a = np.concatenate([np.repeat(vector_a, 3), self.distance_a])
+        side_b = np.concatenate([np.repeat(vector_b, 3), self.distance_b])
+        self.sides = tuple((side, owner[side], carbonyl[side]) for side in (side_a, side_b))
+        self.vector_direction = weights.reshape(-1, 3)
 
-        self.points0 = np.concatenate(points)
-        self.owner = np.concatenate(owners)
-        self.vector_a, self.vector_b, self.vector_weights = (np.concatenate(t) for t in zip(*vector_terms))
+    def _ramachandran_terms(self, residues: np.ndarray, body_of: np.ndarray, reference: np.ndarray) -> None:
+        """φ (its outer atom: the C before) and ψ (the N after) of the free residues that
+        were not Ramachandran outliers in ``reference``. A row pairs the outer atom, on its
+        own residue, with the same atom carried rigidly by the residue whose angle it is:
+        the angle changes with the difference of the two."""
+        top, bb = self.top, self.top.backbone
+        before, after = np.full(len(bb), -1), np.full(len(bb), -1)
+        before[top.second], after[top.first] = top.first, top.second
+        prev, next_ = before[residues], after[residues]
+        c_before = np.where(prev >= 0, bb[prev, 2], -1)
+        n_after = np.where(next_ >= 0, bb[next_, 0], -1)
+        chain = np.column_stack([c_before, bb[residues, :3], n_after])
+        kind = top.rama_class[residues]
+        p = reference[chain].transpose(1, 0, 2)
+        with np.errstate(invalid="ignore"):
+            region = ramachandran_region(dihedral(*p[:4]), dihedral(*p[1:]), kind)
+        k = np.flatnonzero((chain >= 0).all(axis=1) & (region != OUTLIER))
+        self.rama_atoms, self.rama_kind = chain[k], kind[k]
+        self.rama_owners = np.concatenate([k, k]), np.concatenate([body_of[prev[k]], body_of[next_[k]]])
 
-    def place(self, xyz: np.ndarray, owner: np.ndarray, rotation: np.ndarray, shift: np.ndarray) -> np.ndarray:
-        """Positions of start points ``xyz`` attached to bodies ``owner`` (-1: fixed)."""
-        out = xyz.copy()
-        moving = owner >= 0
-        b = owner[moving]
-        out[moving] = self.centres[b] + shift[b] + np.einsum("aij,aj->ai", rotation[b], xyz[moving] - self.centres[b])
+    def ramachandran(self, current: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Residuals (radians / σ, φ rows then ψ rows: 0 where allowed) of the angles' way to
+        their nearest allowed region, their gradients with respect to the outer atoms, and
+        where those atoms are."""
+        p = current[self.rama_atoms]
+        # φ of C-N-Cα-C and ψ of N-Cα-C-N: the φ rows, then the ψ rows
+        angle, first, last = _dihedrals(*np.concatenate([p[:, :4], p[:, 1:]]).transpose(1, 0, 2))
+        m = len(p)
+        degrees = np.degrees(angle)
+        target = np.concatenate(nearest_allowed(degrees[:m], degrees[m:], self.rama_kind))
+        off = np.where(target != degrees, (angle - np.radians(target) + np.pi) % (2 * np.pi) - np.pi, 0.0)
+        sigma = np.radians(RAMACHANDRAN_SIGMA)
+        gradient = np.concatenate([first[:m], last[m:]]) * ((off != 0) / sigma)[:, None]
+        return off / sigma, gradient, np.concatenate([p[:, 0], p[:, 4]])
+
+    def place(self, state: _State) -> np.ndarray:
+        """Positions at ``state`` of the term points, then of the atoms of the free residues."""
+        out = self.start.copy()
+        k = self.turning_body
+        out[self.turning] = self.pivot[k] + _turned(out[self.turning] - self.pivot[k], self.axis[k], state.psi[k])
+        b = self.moving_body
+        centre = self.centre[b]
+        turned = np.einsum("aij,aj->ai", state.rotation[b], out[self.moving] - centre)
+        out[self.moving] = centre + state.shift[b] + turned
         return out
 
-    def atoms(self, rotation: np.ndarray, shift: np.ndarray) -> np.ndarray:
-        """All atom positions with the free residues moved."""
-        current = self.coords.copy()
-        current[self.rows] = self.place(self.coords[self.rows], self.body_of_atom[self.rows], rotation, shift)
-        return current
+    def atoms(self, state: _State, placed: np.ndarray | None = None) -> np.ndarray:
+        """All atom positions with the free residues at ``state`` (one buffer, rewritten by
+        every call); ``placed``: :meth:`place` of ``state`` if known."""
+        self.current[self.rows] = (self.place(state) if placed is None else placed)[self.n_points :]
+        return self.current
 
     def clash_pairs(self, current: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Pairs with a free atom within CLASH_MARGIN of clashing, and the distance each
         should keep: its contact distance less CLASH_TARGET, or its distance before."""
+        moving = current[self.free_atoms]
+        if self.listed_at is None or np.max(np.abs(moving - self.listed_at)) > SKIN / 2:
+            self._list_candidates(current)
+        i, j = self.candidate_i, self.candidate_j
+        near = distance(current[i], current[j]) < self.candidate_limit
+        return i[near], j[near], self.candidate_d_min[near]
+
+    def _list_candidates(self, current: np.ndarray) -> None:
+        """The pairs that may clash while no free atom moves more than SKIN / 2 from here
+        (a Verlet list), with their clash limit and the distance each should keep."""
         reach = CLASH_TARGET - CLASH_MARGIN
-        cutoff = self.top.search_radius(reach)
+        cutoff = self.top.search_radius(reach) + SKIN
         moving = current[self.free_atoms]
         if self.surroundings is None or np.any(moving < self.box[0]) or np.any(moving > self.box[1]):
-            self._surround(current, cutoff)
+            self.box = moving.min(axis=0) - SURROUNDINGS, moving.max(axis=0) + SURROUNDINGS
+            low, high = self.box[0] - cutoff, self.box[1] + cutoff
+            fixed = np.flatnonzero(self.top.checked & (self.atom_body < 0))
+            self.surroundings = fixed[np.all((current[fixed] >= low) & (current[fixed] <= high), axis=1)]
+            self.surroundings_tree = cKDTree(current[self.surroundings])
         tree = cKDTree(moving)
         inner = tree.query_pairs(cutoff, output_type="ndarray")
         outer = tree.sparse_distance_matrix(self.surroundings_tree, cutoff, output_type="ndarray")
         i = np.concatenate([self.free_atoms[inner[:, 0]], self.free_atoms[outer["i"]]])
         j = np.concatenate([self.free_atoms[inner[:, 1]], self.surroundings[outer["j"]]])
         i, j = np.minimum(i, j), np.maximum(i, j)
-        keep = self.body_of_atom[i] != self.body_of_atom[j]
-        i, j = self.top.screen(current, i[keep], j[keep], reach)
-        d_min = np.minimum(self.top.contact(i, j) - CLASH_TARGET, distance(self.reference[i], self.reference[j]))
-        return i, j, d_min
-
-    def _surround(self, current: np.ndarray, cutoff: float) -> None:
-        """The fixed atoms near the free ones (a tree, kept while the free atoms stay in a box)."""
-        moving = current[self.free_atoms]
-        self.box = moving.min(axis=0) - SURROUNDINGS, moving.max(axis=0) + SURROUNDINGS
-        low, high = self.box[0] - cutoff, self.box[1] + cutoff
-        fixed = np.flatnonzero(self.top.checked & (self.body_of_atom < 0))
-        self.surroundings = fixed[np.all((current[fixed] >= low) & (current[fixed] <= high), axis=1)]
-        self.surroundings_tree = cKDTree(current[self.surroundings])
+        keep = (self.atom_body[i] != self.atom_body[j]) | (self.atom_turns[i] != self.atom_turns[j])  # O turns
+        i, j = self.top.screen(current, i[keep], j[keep], reach - SKIN)
+        contact = self.top.contact(i, j)
+        self.candidate_i, self.candidate_j, self.candidate_limit = i, j, contact - reach
+        self.candidate_d_min = np.minimum(contact - CLASH_TARGET, distance(self.reference[i], self.reference[j]))
+        self.listed_at = moving
 
     def violated(self, residual: np.ndarray) -> bool:
-        """Whether a junction is off by more than 0.02 Å or a pair overlaps by more than 0.4 Å."""
-        junction = np.abs(residual[: self.n_junction_rows]) * JUNCTION_SIGMA
-        start = len(self.vector_a) * 3
-        distance_rows = np.abs(residual[start : start + len(self.distance_d0)]) * JUNCTION_SIGMA
-        clash = residual[start + len(self.distance_d0) :] * CLASH_SIGMA
-        return bool(np.any(junction > 0.02) or np.any(distance_rows > 0.02) or np.any(clash < CLASH_TARGET - 0.4))
+        """Whether validation could still flag a junction (a point of it off by more than
+        JUNCTION_SLACK), a residue (a Ramachandran outlier) or a clash (a pair overlapping
+        by more than CLASH_OVERLAP)."""
+        start = self.n_vector_rows
+        stop = start + len(self.distance_d0)
+        junction = np.abs(np.concatenate([residual[: self.n_junction_rows], residual[start:stop]])) * JUNCTION_SIGMA
+        rama = residual[stop : stop + 2 * len(self.rama_atoms)]
+        clash = residual[stop + len(rama) :] * CLASH_SIGMA
+        return bool(np.any(junction > JUNCTION_SLACK) or np.any(rama != 0)
+                    or np.any(clash < CLASH_TARGET - CLASH_OVERLAP))
 
-    def evaluate(self, rotation: np.ndarray, shift: np.ndarray) -> tuple[np.ndarray, tuple]:
-        """Residuals, and what :meth:`jacobian` needs to differentiate them."""
-        x = self.place(self.points0, self.owner, rotation, shift)
-        current = self.atoms(rotation, shift)
+    def evaluate(self, state: _State) -> tuple[np.ndarray, tuple]:
+        """Residuals at ``state``, and what :meth:`jacobian` needs to differentiate them."""
+        x = self.place(state)
+        current = self.atoms(state, x)
         # vector terms: W (x_b - x_a), one residual per row of W
-        a, b = np.repeat(self.vector_a, 3), np.repeat(self.vector_b, 3)
         vector_residual = np.einsum("kij,kj->ki", self.vector_weights, x[self.vector_b] - x[self.vector_a]).ravel()
         # distance terms (|x_b - x_a| - d0) / σ; clash terms softplus(d_min - |x_b - x_a|) / σ
         i, j, d_min = self.clash_pairs(current)
-        pair_a = np.concatenate([x[self.distance_a], current[i]])
-        pair_b = np.concatenate([x[self.distance_b], current[j]])
         n_distance = len(self.distance_d0)
+        pair_a = np.concatenate([x[self.distance_a], current[i]])
+        vector = np.concatenate([x[self.distance_b], current[j]]) - pair_a
         sigma = np.concatenate([np.full(n_distance, JUNCTION_SIGMA), np.full(len(i), CLASH_SIGMA)])
-        vector = pair_b - pair_a
         length = np.linalg.norm(vector, axis=1)
         gap = length - np.concatenate([self.distance_d0, d_min])
         value, slope = gap.copy(), np.ones(len(gap))
@@ -323,114 +449,108 @@ class _Problem:
         value[n_distance:] = -CLASH_SOFTNESS * np.logaddexp(0.0, z)
         slope[n_distance:] = 1.0 / (1.0 + np.exp(-z))
         unit = (slope / sigma)[:, None] * vector / np.maximum(length, 1e-12)[:, None]
-        residual = np.concatenate([vector_residual, value / sigma])
-        direction = np.concatenate([self.vector_weights.reshape(-1, 3), unit])
-        xa, xb = np.concatenate([x[a], pair_a]), np.concatenate([x[b], pair_b])
-        oa = np.concatenate([self.owner[a], self.owner[self.distance_a], self.body_of_atom[i]])
-        ob = np.concatenate([self.owner[b], self.owner[self.distance_b], self.body_of_atom[j]])
-        return residual, (xa, xb, oa, ob, direction, self.centres + shift)
+        rama, rama_direction, outer = self.ramachandran(current)
+        residual = np.concatenate([vector_residual, value[:n_distance] / sigma[:n_distance], rama,
+                                   value[n_distance:] / sigma[n_distance:]])
+        no_turn = np.zeros(len(outer), dtype=bool)
+        sides = tuple(
+            (np.concatenate([x[points], outer, current[atoms]]),
+             np.concatenate([owner, rama_owner, self.atom_body[atoms]]),
+             np.concatenate([turns, no_turn, self.atom_turns[atoms]]))
+            for (points, owner, turns), rama_owner, atoms in zip(self.sides, self.rama_owners, (i, j))
+        )
+        direction = np.concatenate([self.vector_direction, unit[:n_distance], rama_direction, unit[n_distance:]])
+        return residual, (*sides, direction, state)
 
     def jacobian(self, terms: tuple) -> sparse.csr_matrix:
-        """The Jacobian of the residuals with respect to (δt, δω) of every body: each residual
-        is ``direction . x_b - direction . x_a`` to first order, and
-        ``d(direction . x)/d(δt, δω) = (direction, (x - c) x direction)`` for the body of x."""
-        xa, xb, oa, ob, direction, centre = terms
-        rows, cols, vals = [], [], []
-        for xyz, owner, sign in ((xb, ob, 1.0), (xa, oa, -1.0)):
-            moving = np.flatnonzero(owner >= 0)
-            body = owner[moving]
-            lever = np.cross(xyz[moving] - centre[body], direction[moving])
-            rows.append(np.repeat(moving, 6))
-            cols.append((6 * body[:, None] + np.arange(6)).ravel())
-            vals.append(sign * np.concatenate([direction[moving], lever], axis=1).ravel())
-        return sparse.csr_matrix(
-            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(len(direction), 6 * self.n_bodies)
-        )
+        """The Jacobian of the residuals with respect to (δt, δω, δψ) of every body.
+
+        To first order each residual is ``d . x_b - d . x_a``, and for a point ``x`` of a
+        body with Cα at ``c`` and carbonyl axis ``a`` through its C at ``p``
+        ``d(d . x)/d(δt, δω, δψ) = (d, (x - c) x d, a . ((x - p) x d))``, the last for
+        carbonyl points only. Each row has the 7 entries of each moving side.
+        """
+        (xa, oa, ta), (xb, ob, tb), direction, state = terms
+        centre = self.centre + state.shift
+        axis = np.einsum("bij,bj->bi", state.rotation, self.axis)
+        pivot = centre + np.einsum("bij,bj->bi", state.rotation, self.pivot - self.centre)
+        n = len(direction)
+        xyz, owner, turns = np.concatenate([xa, xb]), np.concatenate([oa, ob]), np.concatenate([ta, tb])
+        body = owner.clip(min=0)
+        both = np.concatenate([-direction, direction])  # x_a enters with a minus sign
+        block = np.empty((2 * n, PARAMETERS))
+        block[:, :3] = both
+        block[:, 3:6] = _cross(xyz - centre[body], both)
+        block[:, 6] = np.einsum("ij,ij->i", axis[body], _cross(xyz - pivot[body], both))
+        mask = np.repeat((owner >= 0)[:, None], PARAMETERS, axis=1)
+        mask[:, 6] &= turns
+        # row k of the Jacobian: the entries of side a, then of side b
+        mask = mask.reshape(2, n, PARAMETERS).transpose(1, 0, 2)
+        data = block.reshape(2, n, PARAMETERS).transpose(1, 0, 2)[mask]
+        columns = (PARAMETERS * body[:, None] + np.arange(PARAMETERS)).reshape(2, n, PARAMETERS).transpose(1, 0, 2)
+        indptr = np.concatenate([[0], np.cumsum(mask.sum(axis=(1, 2)))])
+        return sparse.csr_matrix((data, columns[mask], indptr), shape=(n, PARAMETERS * self.n_bodies))
 
     def solve(self) -> Relaxation:
         """Levenberg–Marquardt from the start positions."""
-        rotation = np.broadcast_to(np.eye(3), (self.n_bodies, 3, 3)).copy()
-        shift = np.zeros((self.n_bodies, 3))
-        residual, terms = self.evaluate(rotation, shift)
+        state = _State.start(self.n_bodies)
+        residual, terms = self.evaluate(state)
         jacobian = self.jacobian(terms)
         cost = 0.5 * residual @ residual
-        damping = DAMPING
+        damping, growth = DAMPING, 2.0
         iterations = 0
         for iterations in range(1, MAX_ITERATIONS + 1):
             step = -_solve_normal(jacobian, residual, damping)
+            per_body = step.reshape(-1, PARAMETERS)
+            reach = max(np.abs(per_body[:, :3]).max() / STEP_SHIFT,
+                        np.abs(per_body[:, 3:]).max() / np.radians(STEP_TURN))
+            limited = reach > 1.0
+            if limited:
+                step /= reach
             predicted = cost - 0.5 * np.sum((residual + jacobian @ step) ** 2)
-            trial = _moved(rotation, shift, step)
-            trial_residual, terms = self.evaluate(*trial)
+            trial = state.moved(step)
+            trial_residual, terms = self.evaluate(trial)
             trial_cost = 0.5 * trial_residual @ trial_residual
             if trial_cost < cost:
-                (rotation, shift), residual, jacobian, cost = trial, trial_residual, self.jacobian(terms), trial_cost
-                damping = max(damping / 3, 1e-7)
-                if predicted < TOLERANCE * cost and (predicted < 0.1 * TOLERANCE * cost or not self.violated(residual)):
+                gain = (cost - trial_cost) / max(predicted, 1e-300)
+                state, residual, jacobian, cost = trial, trial_residual, self.jacobian(terms), trial_cost
+                damping = max(damping * max(1 / 3, 1 - (2 * gain - 1) ** 3), 1e-7)
+                growth = 2.0
+                converged = predicted < STALL * cost or (predicted < TOLERANCE * cost and not self.violated(residual))
+                if converged and not limited:
                     break
             else:
-                damping *= 4
-        return Relaxation(self.rows, self.atoms(rotation, shift)[self.rows], iterations, float(cost))
+                damping *= growth
+                growth *= 2
+        return Relaxation(self.rows, self.atoms(state)[self.rows].copy(), iterations, float(cost))
 
 
 def _solve_normal(jacobian: sparse.csr_matrix, residual: np.ndarray, damping: float) -> np.ndarray:
     """Solve the damped normal equations ``(J^T J + λ D) δ = J^T r`` (D its diagonal).
 
     Bodies are residues in chain order: junctions couple neighbouring bodies and most
-    clash pairs residues a few apart (i, i+3 and i+4 in helices), so the matrix of 6 x 6
-    blocks is banded but for a few blocks of residues in contact across the fold.
-    Conjugate gradients, preconditioned with the banded Cholesky factor of its band of
-    BAND_BLOCKS blocks, converge in a few steps of O(m) each.
+    clash pairs residues a few apart, so the matrix is sparse and nearly banded; SuperLU
+    (a fill-reducing order, no pivoting: it is positive definite) factors it in O(m).
     """
-    normal = (jacobian.T @ jacobian).tocsr()
-    diagonal = normal.diagonal()
-    damped = (1.0 + damping) * diagonal + 1e-12 * diagonal.max()
-    entries = normal.tocoo()
-    lower = (entries.row > entries.col) & (entries.row // 6 - entries.col // 6 <= BAND_BLOCKS)
-    band = np.zeros((6 * BAND_BLOCKS + 6, len(damped)))
-    band[entries.row[lower] - entries.col[lower], entries.col[lower]] = entries.data[lower]
-    band[0] = damped
-    factor, info = linalg.lapack.dpbtrf(band, lower=1)
-    if info:
-        raise np.linalg.LinAlgError("normal equations are not positive definite")
-
-    def multiply(v: np.ndarray) -> np.ndarray:
-        return normal @ v + (damped - diagonal) * v
-
-    def precondition(v: np.ndarray) -> np.ndarray:
-        return linalg.lapack.dpbtrs(factor, v, lower=1)[0]
-
-    b = jacobian.T @ residual
-    x = precondition(b)
-    z0 = x.copy()
-    r = b - multiply(x)
-    z = precondition(r)
-    p = z
-    rz = r @ z
-    for _ in range(CG_STEPS):
-        if rz <= CG_TOLERANCE * (b @ z0):
-            break
-        q = multiply(p)
-        alpha = rz / (p @ q)
-        x += alpha * p
-        r -= alpha * q
-        z = precondition(r)
-        rz, rz_old = r @ z, rz
-        p = z + (rz / rz_old) * p
-    return x
-
-
-def _moved(rotation: np.ndarray, shift: np.ndarray, step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rotations and shifts after the step ``step``, (δt, δω) per body flattened."""
-    step = step.reshape(-1, 6)
-    return np.einsum("bij,bjk->bik", Rotation.from_rotvec(step[:, 3:]).as_matrix(), rotation), shift + step[:, :3]
+    normal = (jacobian.T @ jacobian).tocsc()  # symmetric: its CSR arrays are its CSC arrays
+    column = np.repeat(np.arange(normal.shape[1]), np.diff(normal.indptr))
+    diagonal = np.flatnonzero(normal.indices == column)
+    if len(diagonal) == normal.shape[1]:
+        normal.data[diagonal] *= 1.0 + damping
+        normal.data[diagonal] += 1e-12 * normal.data[diagonal].max()
+    else:  # a parameter that no term moves (the ψ of a residue without O)
+        diagonal = normal.diagonal()
+        normal = (normal + sparse.diags(damping * diagonal + 1e-12 * diagonal.max() + 1e-12, format="csc")).tocsc()
+    factor = splu(normal, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+    return factor.solve(jacobian.T @ residual)
 
 
 def _normal_planes(along: np.ndarray) -> np.ndarray:
     """(m, 2, 3) two unit vectors perpendicular to each unit vector of ``along`` (m, 3)."""
     helper = np.eye(3)[np.argmin(np.abs(along), axis=1)]
-    first = np.cross(along, helper)
+    first = _cross(along, helper)
     first /= np.linalg.norm(first, axis=1, keepdims=True)
-    return np.stack([first, np.cross(along, first)], axis=1)
+    return np.stack([first, _cross(along, first)], axis=1)
 
 
 def _ideal_next(
@@ -458,3 +578,40 @@ def _ideal_next(
 
 def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products of (k, 3) arrays (``np.cross`` costs more for short arrays)."""
+    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
+    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=1)
+
+
+def _dihedrals(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Dihedral angles a–b–c–d (radians; rows of (k, 3) arrays, as
+    :func:`core.validation.dihedral`) and their gradients (per Å) with respect to a and d."""
+    b1, b2, b3 = b - a, c - b, d - c
+    n1, n2 = _cross(b1, b2), _cross(b2, b3)
+    length = np.linalg.norm(b2, axis=1)
+    angle = np.arctan2(length * np.einsum("ij,ij->i", b1, n2), np.einsum("ij,ij->i", n1, n2))
+    first = -length[:, None] * n1 / np.einsum("ij,ij->i", n1, n1)[:, None]
+    last = length[:, None] * n2 / np.einsum("ij,ij->i", n2, n2)[:, None]
+    return angle, first, last
+
+
+def _off_axis(points: np.ndarray, through: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """Distances (Å) of ``points`` from the lines through ``through`` along unit ``axis`` (all (k, 3))."""
+    arm = points - through
+    return np.linalg.norm(arm - np.einsum("ij,ij->i", arm, axis)[:, None] * axis, axis=1)
+
+
+def _torsion_weights(radius: np.ndarray) -> np.ndarray:
+    """(k, 3, 3) weights that make a point ``radius`` Å off a bond, turned about it, a
+    residual of about (turn / TORSION_SIGMA) per row."""
+    return np.eye(3) / (np.radians(TORSION_SIGMA) * radius)[:, None, None]
+
+
+def _turned(v: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Vectors ``v`` (k, 3) turned by ``angle`` (k,) about unit vectors ``axis`` (k, 3) (Rodrigues)."""
+    cos, sin = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    return v * cos + _cross(axis, v) * sin + axis * np.einsum("ij,ij->i", axis, v)[:, None] * (1.0 - cos)

@@ -34,7 +34,7 @@ import functools
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import sparse
+from scipy import ndimage, sparse
 from scipy.spatial import cKDTree
 
 from .structure import Structure
@@ -189,6 +189,30 @@ def ramachandran_region(phi: np.ndarray, psi: np.ndarray, kind: np.ndarray) -> n
     column = np.clip(((np.asarray(phi) + 180.0) // 20).astype(np.int64), 0, 17)
     row = np.clip(((180.0 - np.asarray(psi)) // 20).astype(np.int64), 0, 17)
     return RAMACHANDRAN[np.asarray(kind), row, column]
+
+
+def nearest_allowed(phi: np.ndarray, psi: np.ndarray, kind: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The allowed (φ, ψ) nearest to each (φ, ψ) in degrees, to 2° (itself where allowed;
+    the values may lie beyond ±180 on the other side of the wrap)."""
+    column = ((np.asarray(phi) + 180.0) // 2).astype(np.int64) % 180
+    row = ((180.0 - np.asarray(psi)) // 2).astype(np.int64) % 180
+    target = _nearest_allowed_cells()[np.asarray(kind), row, column]
+    allowed = ramachandran_region(phi, psi, kind) != OUTLIER
+    return np.where(allowed, phi, target[..., 0]), np.where(allowed, psi, target[..., 1])
+
+
+@functools.lru_cache(maxsize=1)
+def _nearest_allowed_cells() -> np.ndarray:
+    """(classes, 180, 180, 2): per class and 2° cell (ψ row from +180 down, φ column from
+    -180), the (φ, ψ) centre of the nearest allowed 2° cell, across the periodic wrap."""
+    fine = np.repeat(np.repeat(RAMACHANDRAN == OUTLIER, 10, axis=1), 10, axis=2)
+    out = np.empty((len(fine), 180, 180, 2))
+    for k, outlier in enumerate(fine):
+        _, (row, column) = ndimage.distance_transform_edt(np.tile(outlier, (3, 3)), return_indices=True)
+        row, column = row[180:360, 180:360] - 180, column[180:360, 180:360] - 180
+        out[k, ..., 0] = -180.0 + 2 * column + 1
+        out[k, ..., 1] = 180.0 - 2 * row - 1
+    return out
 
 
 # ------------------------------------------------------------------------- topology

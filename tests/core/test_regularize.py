@@ -63,6 +63,10 @@ def clash_pairs(structure, coords):
     return {f.where for f in validate(structure, coords).flags if f.kind == "clash"}
 
 
+def outliers(structure, coords):
+    return {f.where for f in validate(structure, coords).flags if f.kind == "ramachandran"}
+
+
 def test_regularization_fixes_a_five_angstrom_edit_of_ubiquitin(ubiquitin):
     """The issue's acceptance test: level 3, one control point moved 5 Å."""
     model = EditableModel(ubiquitin)
@@ -77,12 +81,14 @@ def test_regularization_fixes_a_five_angstrom_edit_of_ubiquitin(ubiquitin):
     assert np.all(np.abs(c_n - 1.33) <= 0.05)
     assert np.all(np.abs(ca_ca - 3.80) <= 0.1)  # 1UBQ has no cis peptide
     assert clash_pairs(ubiquitin, after) <= clash_pairs(ubiquitin, ubiquitin.coords)
+    assert outliers(ubiquitin, after) <= outliers(ubiquitin, ubiquitin.coords)  # φ and ψ stay allowed
     # each residue carries its curve point C^r rigidly: it stays within 0.5 Å rms of the edited curve
     ribbon = model.ribbons[0]
     u = ribbon.residue_u[fixed.residues]
     carried = []
     for k, residue in enumerate(fixed.residues):
         rows = np.arange(ubiquitin.segments[0].atom_start[residue], ubiquitin.segments[0].atom_stop[residue])
+        rows = rows[~np.isin(ubiquitin.atoms.name[rows], ("O", "OXT"))]  # the rigid part: the carbonyl turns
         rotation, shift = kabsch(edited[rows], after[rows])
         carried.append(rotation @ ribbon.space.evaluate(edit.new_points, u[k : k + 1])[0] + shift)
     curve = ribbon.space.evaluate(edit.new_points, np.linspace(0, 1, 40001))
@@ -90,7 +96,7 @@ def test_regularization_fixes_a_five_angstrom_edit_of_ubiquitin(ubiquitin):
     assert np.sqrt(np.mean(np.square(distances))) < 0.5
 
 
-@pytest.mark.parametrize(("level", "point"), [(2, 1), (2, 3), (3, 2), (3, 6), (4, 6), (4, 10), (4.5, 12)])
+@pytest.mark.parametrize(("level", "point"), [(2, 1), (2, 3), (3, 2), (3, 6), (4, 6), (4, 10), (4.5, 12), (5, 18)])
 def test_regularized_edits_have_ideal_junctions_and_no_new_clashes(ubiquitin, level, point):
     model = EditableModel(ubiquitin)
     fixed = regularized(model, outward_edit(model, level, point))
@@ -98,6 +104,7 @@ def test_regularized_edits_have_ideal_junctions_and_no_new_clashes(ubiquitin, le
     report = validate(ubiquitin, after)
     assert sum(report.counts[k] for k in ("peptide_bond", "ca_ca", "angle_ca_c_n", "angle_c_n_ca", "omega")) == 0
     assert clash_pairs(ubiquitin, after) <= clash_pairs(ubiquitin, ubiquitin.coords)
+    assert outliers(ubiquitin, after) <= outliers(ubiquitin, ubiquitin.coords)  # (5, 18): 2 without the Ramachandran term
 
 
 def test_regularized_edit_is_one_exact_undo_step(ubiquitin):
@@ -120,16 +127,29 @@ def test_regularized_edit_is_one_exact_undo_step(ubiquitin):
     assert np.array_equal(model.coords, ubiquitin.coords)
 
 
-def test_residues_stay_rigid(ubiquitin):
+def test_residues_keep_their_geometry_and_turn_only_psi(ubiquitin):
+    """Each residue moves rigidly but for its carbonyl O, which turns about the Cα–C bond
+    (ψ): every bond length and angle of the residue stays as it was."""
     model = EditableModel(ubiquitin)
     fixed = regularized(model, outward_edit(model, 3, 4))
     after = coords_after(model, fixed)
-    segment = ubiquitin.segments[0]
+    segment, atoms = ubiquitin.segments[0], ubiquitin.atoms
+    pairwise = lambda x: np.linalg.norm(x[:, None] - x[None], axis=-1)  # noqa: E731
+    turned = []
     for residue in fixed.residues:
-        rows = segment.atoms(residue)
-        before, now = ubiquitin.coords[rows], after[rows]
-        pairwise = lambda x: np.linalg.norm(x[:, None] - x[None], axis=-1)  # noqa: E731
-        assert np.abs(pairwise(now) - pairwise(before)).max() < 1e-9
+        rows = np.arange(segment.atom_start[residue], segment.atom_stop[residue])
+        carbonyl = np.isin(atoms.name[rows], ("O", "OXT"))
+        body = rows[~carbonyl]
+        assert np.abs(pairwise(after[body]) - pairwise(ubiquitin.coords[body])).max() < 1e-9
+        ca, c = (rows[atoms.name[rows] == name][0] for name in ("CA", "C"))
+        for o in rows[carbonyl]:  # the O–C bond and the Cα–C–O angle (the O–Cα distance)
+            for partner in (c, ca):
+                before = np.linalg.norm(ubiquitin.coords[o] - ubiquitin.coords[partner])
+                assert abs(np.linalg.norm(after[o] - after[partner]) - before) < 1e-9
+        frame = rows[np.isin(atoms.name[rows], ("N", "CA", "C"))]
+        rotation, shift = kabsch(ubiquitin.coords[frame], after[frame])
+        turned.append(max(np.linalg.norm(rotation @ ubiquitin.coords[o] + shift - after[o]) for o in rows[carbonyl]))
+    assert max(turned) > 0.05  # ψ did change somewhere
 
 
 def test_regularize_region_after_a_plain_edit(ubiquitin):
@@ -188,11 +208,14 @@ def test_nothing_to_regularize_and_bad_arguments(ubiquitin):
         regularize_region(model, 0, [80])
 
 
-def test_analytic_jacobian_matches_finite_differences(ubiquitin):
-    """Junction, tether and clash terms are differentiated by hand; check against numbers."""
+@pytest.mark.parametrize("turn", [0.05, 0.3])
+def test_analytic_jacobian_matches_finite_differences(ubiquitin, turn):
+    """Junction, tether, torsion, Ramachandran, clash and carbonyl-turn terms are
+    differentiated by hand; check against numbers (the larger turns make Ramachandran
+    outliers, whose rows are zero elsewhere)."""
     from scipy.spatial.transform import Rotation
 
-    from core.regularize import _moved, _Problem
+    from core.regularize import PARAMETERS, _Problem, _State
 
     model = EditableModel(ubiquitin)
     edit = outward_edit(model, 4, 8)
@@ -203,17 +226,21 @@ def test_analytic_jacobian_matches_finite_differences(ubiquitin):
                        ribbon.space.evaluate(edit.new_points, u), ribbon.space.evaluate(edit.new_points, u, 1),
                        ubiquitin.coords)
     rng = np.random.default_rng(5)
-    rotation = Rotation.from_rotvec(rng.normal(scale=0.05, size=(problem.n_bodies, 3))).as_matrix()
-    shift = rng.normal(scale=0.1, size=(problem.n_bodies, 3))
-    residual, terms = problem.evaluate(rotation, shift)
+    n = problem.n_bodies
+    state = _State(Rotation.from_rotvec(rng.normal(scale=turn, size=(n, 3))).as_matrix(),
+                   rng.normal(scale=0.1, size=(n, 3)), rng.normal(scale=0.2, size=n))
+    residual, terms = problem.evaluate(state)
     analytic = problem.jacobian(terms).toarray()
-    pairs, _, _ = problem.clash_pairs(problem.atoms(rotation, shift))
+    pairs, _, _ = problem.clash_pairs(problem.atoms(state))
     assert len(pairs) > 10  # clash terms are part of the check
+    assert np.abs(analytic[:, PARAMETERS - 1 :: PARAMETERS]).max() > 1.0  # and so are the carbonyl turns
+    rama, _, _ = problem.ramachandran(problem.atoms(state))
+    assert np.count_nonzero(rama) > (5 if turn > 0.1 else -1)
     h = 1e-6
     numeric = np.empty_like(analytic)
     for column in range(analytic.shape[1]):
         step = np.zeros(analytic.shape[1])
         step[column] = h
-        moved, _ = problem.evaluate(*_moved(rotation, shift, step))
+        moved, _ = problem.evaluate(state.moved(step))
         numeric[:, column] = (moved - residual) / h
     assert np.abs(analytic - numeric).max() < 1e-3 * np.abs(analytic).max()

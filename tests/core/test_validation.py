@@ -10,7 +10,7 @@ from scipy.sparse import csgraph, csr_matrix
 from core.model import EditableModel
 from core.structure import read_structure
 from core.validation import (
-    FAVOURED, KINDS, OUTLIER, RAMACHANDRAN, RAMACHANDRAN_CLASSES, angle, dihedral, phi_psi,
+    FAVOURED, KINDS, OUTLIER, RAMACHANDRAN, RAMACHANDRAN_CLASSES, angle, dihedral, nearest_allowed, phi_psi,
     ramachandran_region, topology, validate,
 )  # fmt: skip
 
@@ -108,6 +108,24 @@ def test_ramachandran_regions():
     assert ramachandran_region(-65, 140, proline) == FAVOURED
     # glycine is achiral: its map is symmetric under (φ, ψ) -> (-φ, -ψ)
     assert np.array_equal(RAMACHANDRAN[glycine], RAMACHANDRAN[glycine][::-1, ::-1])
+
+
+def test_nearest_allowed_is_the_closest_allowed_point_across_the_wrap():
+    """Against a brute-force search over allowed points every degree (distances wrap at ±180°)."""
+    rng = np.random.default_rng(3)
+    phi, psi = rng.uniform(-180, 180, size=(2, 400))
+    kind = rng.integers(0, len(RAMACHANDRAN_CLASSES), size=400)
+    to_phi, to_psi = nearest_allowed(phi, psi, kind)
+    wrap = lambda a: (a + 180.0) % 360.0 - 180.0  # noqa: E731
+    allowed = ramachandran_region(phi, psi, kind) != OUTLIER
+    assert np.array_equal(to_phi[allowed], phi[allowed]) and np.array_equal(to_psi[allowed], psi[allowed])
+    assert np.all(ramachandran_region(wrap(to_phi), wrap(to_psi), kind) != OUTLIER)
+    grid_phi, grid_psi = np.meshgrid(np.arange(-179.5, 180), np.arange(-179.5, 180))
+    for k in np.flatnonzero(~allowed):
+        inside = ramachandran_region(grid_phi, grid_psi, kind[k]) != OUTLIER
+        nearest = np.hypot(wrap(grid_phi[inside] - phi[k]), wrap(grid_psi[inside] - psi[k])).min()
+        found = np.hypot(wrap(to_phi[k] - phi[k]), wrap(to_psi[k] - psi[k]))
+        assert nearest - 1.0 <= found <= nearest + 2.5  # found lies 1° inside, on a 2° grid
 
 
 @pytest.mark.parametrize("name", ["1UBQ.pdb.gz", "1EJG.pdb.gz", "3JQH.cif.gz", "1F9V.pdb.gz", "1BD2.pdb.gz",
