@@ -352,9 +352,9 @@ class _Problem:
         self.rama_owners = np.concatenate([k, k]), np.concatenate([body_of[prev[k]], body_of[next_[k]]])
 
     def ramachandran(self, current: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Residuals (radians / σ, φ rows then ψ rows: 0 where allowed) of the angles' way to
-        their nearest allowed region, their gradients with respect to the outer atoms, and
-        where those atoms are."""
+        """How far each φ and ψ is from the nearest allowed Ramachandran region (radians / σ;
+        the φ rows, then the ψ rows; 0 where allowed), the gradients of those residuals with
+        respect to the outer atoms, and where those atoms are."""
         p = current[self.rama_atoms]
         # φ of C-N-Cα-C and ψ of N-Cα-C-N: the φ rows, then the ψ rows
         angle, first, last = _dihedrals(*np.concatenate([p[:, :4], p[:, 1:]]).transpose(1, 0, 2))
