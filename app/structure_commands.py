@@ -165,8 +165,8 @@ def edit_arguments(parser: argparse.ArgumentParser) -> None:
                         help="output file; PDB or mmCIF by the extension (.pdb, .cif, optionally .gz)")
     parser.add_argument("--overwrite", action="store_true", help="replace OUT if it exists (even the input file)")
     parser.add_argument("--regularize", action="store_true",
-                        help="then move the residues again (rigid, turning their carbonyls) to ideal peptide "
-                             "junctions without new clashes or Ramachandran outliers")
+                        help="then move the residues again (rigid, turning carbonyls and clashing side chains) "
+                             "to ideal peptide junctions without new clashes or Ramachandran outliers")
 
 
 def run_edit(args: argparse.Namespace) -> int:

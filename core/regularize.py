@@ -4,7 +4,9 @@ Carson's edits move each residue as a rigid body with its curve frame and apply 
 constraint, so peptide bonds stretch and atoms run into each other. Here the residues an
 edit moved (plus ``flank`` neighbours on each side) are moved again, each as a rigid body
 whose carbonyl O may turn about the Cα–C bond (ψ), to the least-squares best compromise
-(Levenberg–Marquardt, analytic Jacobian, sparse normal equations) of:
+(Levenberg–Marquardt, analytic Jacobian, sparse normal equations) of the terms below.
+Where that leaves something validation would flag, a second fit from there also lets the
+side chains that clash turn about their Cα–Cβ bond (χ1).
 
 - **junctions** (σ = :data:`JUNCTION_SIGMA`): each residue carries the ideal planar
   peptide that follows it, built from its own Cα, C and O with Engh & Huber values
@@ -13,20 +15,25 @@ whose carbonyl O may turn about the Cα–C bond (ψ), to the least-squares best
   angles, ω and the carbonyl planarity and leaves φ and ψ free. Cα-only junctions keep
   their Cα–Cα distance.
 - **the tether to the edited curve**: each residue's curve point C^r stays on the curve
-  (σ = :data:`TETHER_SIGMA` across it, :data:`SLIDE_SIGMA` along it), and its N, Cα, C
-  and O stay near where the edit put them (σ = :data:`ORIENTATION_SIGMA`).
+  (σ = :data:`TETHER_SIGMA` across it, :data:`SLIDE_SIGMA` along it), and its Cα stays
+  near where the edit put it (σ = :data:`HOLD_SIGMA`).
+- **torsions**: φ, ψ and χ1 stay near where the edit put them (σ = :data:`TORSION_SIGMA`),
+  and a φ or ψ that leaves its allowed Ramachandran region is pulled back to the nearest
+  allowed point (σ = :data:`RAMACHANDRAN_SIGMA`).
 - **clashes** (σ = :data:`CLASH_SIGMA`, one-sided and smooth): heavy-atom pairs (those
-  :mod:`core.validation` checks, and a turned O against its own side chain) are pushed
+  :mod:`core.validation` checks, and turned atoms against the rest of their residue) are pushed
   apart until they overlap by at most :data:`CLASH_TARGET`, or by what they overlapped
   before the edit if that was more.
 
-Why rigid residues with a turning carbonyl: the editor moves residues as rigid bodies
-already, and 7 parameters per residue keep every bond length and angle inside a residue
-exact (side chains, rotamers, alternate conformers, hydrogens) while the backbone keeps
-both of its torsions, φ (between residues) and ψ (the carbonyl turn), to close the
-junctions and bend around clashes. Only the backbone can give: side chains stay as they
-were. The normal equations are sparse and nearly banded (junctions couple chain
-neighbours, clashes mostly residues a few apart) and are factored in O(m).
+Why rigid residues with two turns: the editor moves residues as rigid bodies already,
+and 6 parameters per residue, plus a turn about each of two bonds, keep every bond
+length and angle inside a residue exact (alternate conformers and hydrogens included)
+while the backbone keeps both of its torsions, φ (between residues) and ψ (the carbonyl
+turn), to close the junctions and bend around clashes, and a side chain pushed into
+others can swing out of the way (χ1; the further side-chain torsions stay as they were).
+Side chains turn only in the second fit: most edits settle without them, and each
+rotor is one more unknown. The normal equations are sparse and nearly banded (junctions
+couple chain neighbours, clashes mostly residues a few apart) and are factored in O(m).
 Why fixed outer neighbours: the edit's B-spline change fades to zero at the ends of its
 support, so the rest of the chain is left exactly as it was (locality, nothing to redraw
 outside the edit), and the ``flank`` residues just inside absorb the strain at the two
@@ -51,7 +58,7 @@ from .model import Edit, EditableModel
 from .structure import Structure
 from .validation import (
     C_N, C_N_CA, C_N_CA_PRO, C_N_PRO, CA_C_N, CA_C_N_PRO, CA_CA_CIS, CA_CA_TRANS, CLASH_OVERLAP, OUTLIER,
-    dihedral, distance, nearest_allowed, ramachandran_region, topology,
+    Topology, dihedral, distance, nearest_allowed, ramachandran_region, topology,
 )  # fmt: skip
 
 FLANK = 3
@@ -67,8 +74,8 @@ SLIDE_SIGMA = 1.0
 HOLD_SIGMA = 1.0
 """Å; a weak hold of each Cα where the edit put it."""
 TORSION_SIGMA = 15.0
-"""Degrees; how far φ and ψ may turn from where the edit put them (which keeps residues
-in their Ramachandran regions)."""
+"""Degrees; how far φ, ψ and χ1 may turn from where the edit put them (which keeps
+residues in their Ramachandran regions and side chains in their rotamers)."""
 RAMACHANDRAN_SIGMA = 0.5
 """Degrees; the scale of a φ's or ψ's distance from the nearest allowed Ramachandran
 region (residues that were outliers before the edit are left as they are)."""
@@ -100,8 +107,11 @@ STEP_SHIFT = 1.0
 STEP_TURN = 20.0
 """Degrees; ... or turns it or its carbonyl farther (the whole step is scaled down): the
 clash and Ramachandran terms act only once crossed, so a long step could jump across."""
-PARAMETERS = 7
-"""Per body: a shift, a rotation vector and the turn ψ of the carbonyl about Cα–C."""
+ROTORS = 2
+"""Turns inside a residue: the carbonyl about Cα–C (ψ) and the side chain about Cα–Cβ (χ1)."""
+PSI, CHI1, NO_ROTOR = 0, 1, -1
+PARAMETERS = 6 + ROTORS
+"""Per body: a shift, a rotation vector and the turns of its rotors."""
 
 
 @dataclass(frozen=True)
@@ -114,12 +124,14 @@ class Relaxation:
     coords : (k, 3) their new positions, Å.
     iterations : Levenberg–Marquardt steps tried.
     cost : final objective, ½ Σ (residual / σ)².
+    settled : whether validation would flag nothing the least squares sees.
     """
 
     rows: np.ndarray
     coords: np.ndarray
     iterations: int
     cost: float
+    settled: bool
 
 
 def regularized(model: EditableModel, edit: Edit, *, flank: int = FLANK) -> Edit:
@@ -173,8 +185,8 @@ def relax(
     tangents: np.ndarray,
     reference: np.ndarray | None = None,
 ) -> Relaxation:
-    """Move ``residues`` (rigid, their carbonyls turning about Cα–C) to ideal junctions,
-    on the curve, without new clashes.
+    """Move ``residues`` (rigid, turning carbonyls and clashing side chains) to ideal
+    junctions, on the curve, without new clashes.
 
     Parameters
     ----------
@@ -199,8 +211,19 @@ def relax(
         if np.shape(array) != (len(residues), 3):
             raise ValueError(f"{name} must have shape ({len(residues)}, 3); got {np.shape(array)}")
     if len(residues) == 0:
-        return Relaxation(np.zeros(0, dtype=np.int64), np.zeros((0, 3)), 0, 0.0)
-    return _Problem(structure, coords, residues, np.asarray(anchors, float), np.asarray(tangents, float), reference).solve()
+        return Relaxation(np.zeros(0, dtype=np.int64), np.zeros((0, 3)), 0, 0.0, True)
+    anchors, tangents = np.asarray(anchors, float), np.asarray(tangents, float)
+    backbone = _Problem(structure, coords, residues, anchors, tangents, reference, side_chains=False).solve()
+    if backbone.settled:
+        return backbone
+    # something would still be flagged: side chains that clash may turn too (χ1), from here
+    start = coords.copy()
+    start[backbone.rows] = backbone.coords
+    problem = _Problem(structure, start, residues, anchors, tangents, reference, side_chains=True)
+    if not problem.axis[:, CHI1].any():  # no side chain clashes: nothing new to try
+        return backbone
+    result = problem.solve()
+    return Relaxation(result.rows, result.coords, backbone.iterations + result.iterations, result.cost, result.settled)
 
 
 def _with_flanks(residues: np.ndarray, flank: int, n_residues: int) -> np.ndarray:
@@ -217,21 +240,22 @@ def _with_flanks(residues: np.ndarray, flank: int, n_residues: int) -> np.ndarra
 @dataclass(frozen=True)
 class _State:
     """Where the bodies are: body ``k`` turned by ``rotation[k]`` about its start Cα and
-    moved by ``shift[k]``, its carbonyl turned by ``psi[k]`` about the Cα–C bond first."""
+    moved by ``shift[k]``, its carbonyl and side chain turned first by ``turn[k]`` (ψ about
+    the Cα–C bond, χ1 about the Cα–Cβ bond)."""
 
     rotation: np.ndarray
     shift: np.ndarray
-    psi: np.ndarray
+    turn: np.ndarray
 
     @classmethod
     def start(cls, n_bodies: int) -> _State:
-        return cls(np.broadcast_to(np.eye(3), (n_bodies, 3, 3)).copy(), np.zeros((n_bodies, 3)), np.zeros(n_bodies))
+        return cls(np.broadcast_to(np.eye(3), (n_bodies, 3, 3)).copy(), np.zeros((n_bodies, 3)),
+                   np.zeros((n_bodies, ROTORS)))
 
     def moved(self, step: np.ndarray) -> _State:
-        """The state after ``step``: (δt, δω, δψ) of every body, flattened."""
-        step = step.reshape(-1, PARAMETERS)
+        """The state after ``step``: (m, PARAMETERS) of (δt, δω, δψ, δχ1) per body."""
         turn = Rotation.from_rotvec(step[:, 3:6]).as_matrix()
-        return _State(np.einsum("bij,bjk->bik", turn, self.rotation), self.shift + step[:, :3], self.psi + step[:, 6])
+        return _State(np.einsum("bij,bjk->bik", turn, self.rotation), self.shift + step[:, :3], self.turn + step[:, 6:])
 
 
 class _Problem:
@@ -239,7 +263,9 @@ class _Problem:
 
     A point ``y`` of body ``k`` (residue ``residues[k]``) moves to ``c + t + R (y' - c)``,
     ``c`` the body's start Cα, where ``y' = y`` but for the carbonyl (O, OXT and the ideal
-    next N and Cα built on them), which is first turned by ψ about the start Cα–C axis.
+    next N and Cα built on them), first turned by ψ about the start Cα–C axis, and a
+    clashing side chain beyond Cβ, first turned by χ1 about the start Cα–Cβ axis. The
+    unknowns are 6 per body and one per rotor it has (:attr:`column`).
     Points of the terms belong to a body or to none (-1: fixed). A vector term weighs the
     difference of two points with a 3 x 3 matrix (one residual per row); distance terms
     ask two points to be ``d0`` apart; Ramachandran terms a φ or ψ to be allowed; clash
@@ -247,7 +273,7 @@ class _Problem:
     """
 
     def __init__(self, structure: Structure, coords: np.ndarray, residues: np.ndarray,
-                 anchors: np.ndarray, tangents: np.ndarray, reference: np.ndarray) -> None:
+                 anchors: np.ndarray, tangents: np.ndarray, reference: np.ndarray, side_chains: bool) -> None:
         self.top = top = topology(structure)
         self.reference = reference
         self.n_bodies = n = len(residues)
@@ -257,24 +283,24 @@ class _Problem:
         self.atom_body = np.where(structure.atom_residue >= 0, body_of[structure.atom_residue.clip(min=0)], -1)
         self.rows = np.flatnonzero(self.atom_body >= 0)
         self.centre = coords[bb[residues, 1]]
-        rotor = bb[residues, 2] >= 0
-        self.pivot = np.where(rotor[:, None], coords[bb[residues, 2]], self.centre)
-        self.axis = np.zeros((n, 3))
-        self.axis[rotor] = _unit(self.pivot[rotor] - self.centre[rotor])
-        carbonyl = self.rows[np.isin(structure.atoms.name[self.rows], ("O", "OXT"))]
-        self.atom_turns = np.zeros(len(coords), dtype=bool)
-        self.atom_turns[carbonyl[rotor[self.atom_body[carbonyl]]]] = True
+        self.pivot, self.axis, self.atom_rotor = _rotors(structure, coords, residues, self.atom_body, bb, top, side_chains)
+        rotor = np.any(self.axis != 0, axis=2)  # (n, ROTORS): which bodies have which rotor
+        present = np.concatenate([np.ones((n, 6), dtype=bool), rotor], axis=1)
+        self.column = np.where(present, np.cumsum(present).reshape(n, PARAMETERS) - 1, -1)
+        self.n_columns = int(present.sum())
         self.current = coords.copy()
         self.free_atoms = self.rows[top.checked[self.rows]]
         self.surroundings: np.ndarray | None = None
         self.listed_at: np.ndarray | None = None
-        points, owners, turns, vector_terms = [], [], [], []
+        points, owners, rotors, vector_terms = [], [], [], []
 
-        def add(xyz: np.ndarray, owner: np.ndarray, turn: bool | np.ndarray) -> np.ndarray:
+        def add(xyz: np.ndarray, owner: np.ndarray, on: int = NO_ROTOR) -> np.ndarray:
+            """Points ``xyz`` of bodies ``owner``, turned by their rotor ``on`` (where they have it)."""
             start = sum(len(p) for p in points)
             points.append(xyz)
             owners.append(owner)
-            turns.append(np.broadcast_to(turn, len(xyz)) & (owner >= 0) & rotor[owner])
+            turned = (owner >= 0) & rotor[owner, on] if on != NO_ROTOR else np.zeros(len(xyz), dtype=bool)
+            rotors.append(np.where(turned, on, NO_ROTOR))
             return np.arange(start, start + len(xyz))
 
         def coincide(a: tuple, b: tuple, weights: np.ndarray) -> None:
@@ -287,32 +313,34 @@ class _Problem:
         f, s = first[full], second[full]
         ideal_n, ideal_ca = _ideal_next(coords, bb[f], bb[s], top.cis[k[full]], top.proline[k[full]])
         stiff = np.eye(3) / JUNCTION_SIGMA
-        coincide((ideal_n, body_of[f], True), (coords[bb[s, 0]], body_of[s], False), stiff)
-        coincide((ideal_ca, body_of[f], True), (coords[bb[s, 1]], body_of[s], False), stiff)
+        coincide((ideal_n, body_of[f], PSI), (coords[bb[s, 0]], body_of[s]), stiff)
+        coincide((ideal_ca, body_of[f], PSI), (coords[bb[s, 1]], body_of[s]), stiff)
         self.n_junction_rows = 6 * len(f)  # the first rows: N and Cα of the next residue, 3 each
         f, s = first[~full], second[~full]  # Cα only: keep the Cα–Cα distance
-        self.distance_a = add(coords[bb[f, 1]], body_of[f], False)
-        self.distance_b = add(coords[bb[s, 1]], body_of[s], False)
+        self.distance_a = add(coords[bb[f, 1]], body_of[f])
+        self.distance_b = add(coords[bb[s, 1]], body_of[s])
         self.distance_d0 = np.where(top.cis[k[~full]], CA_CA_CIS, CA_CA_TRANS)
         self._ramachandran_terms(residues, body_of, reference)
         # the tether: C^r on the curve (free to slide along it), Cα near where it was
         along = _unit(tangents)
         weights = np.concatenate([_normal_planes(along) / TETHER_SIGMA, along[:, None] / SLIDE_SIGMA], axis=1)
-        coincide((anchors, np.full(n, -1), False), (anchors, np.arange(n), False), weights)
-        coincide((self.centre, np.full(n, -1), False), (self.centre, np.arange(n), False), np.eye(3) / HOLD_SIGMA)
+        coincide((anchors, np.full(n, -1)), (anchors, np.arange(n)), weights)
+        coincide((self.centre, np.full(n, -1)), (self.centre, np.arange(n)), np.eye(3) / HOLD_SIGMA)
         # torsions held loosely (each a turn of a point about a bond, 2 r sin(angle / 2) long):
-        # ψ, each O turned against the same O unturned; φ, each C on its residue against the
-        # same C on the carbonyl before it
-        body = np.flatnonzero(rotor & (bb[residues, 3] >= 0))
-        oxygen = coords[bb[residues[body], 3]]
-        radius = _off_axis(oxygen, self.pivot[body], self.axis[body])
-        coincide((oxygen, body, False), (oxygen, body, True), _torsion_weights(radius))
+        # ψ and χ1, the first heavy atom each rotor turns against the same atom unturned; φ, each C
+        # on its residue against the same C on the carbonyl before it
+        for on in (PSI, CHI1):
+            rows = self.free_atoms[self.atom_rotor[self.free_atoms] == on]
+            body, first_row = np.unique(self.atom_body[rows], return_index=True)
+            atom = coords[rows[first_row]]
+            radius = _off_axis(atom, self.pivot[body, on], self.axis[body, on])
+            coincide((atom, body), (atom, body, on), _torsion_weights(radius))
         f, s = first[full], second[full]
         carbon = coords[bb[s, 2]]
         ok = bb[s, 2] >= 0
         f, s, carbon = f[ok], s[ok], carbon[ok]
         radius = _off_axis(carbon, coords[bb[s, 1]], _unit(coords[bb[s, 1]] - coords[bb[s, 0]]))
-        coincide((carbon, body_of[f], True), (carbon, body_of[s], False), _torsion_weights(radius))
+        coincide((carbon, body_of[f], PSI), (carbon, body_of[s]), _torsion_weights(radius))
         vector_a, vector_b, weights = (np.concatenate(t) for t in zip(*vector_terms))
         self.vector_a, self.vector_b, self.vector_weights = vector_a, vector_b, weights
         self.n_vector_rows = 3 * len(vector_a)
@@ -320,15 +348,15 @@ class _Problem:
         self.n_points = sum(len(p) for p in points)
         self.start = np.concatenate([*points, coords[self.rows]])
         owner = np.concatenate([*owners, self.atom_body[self.rows]])
-        carbonyl = np.concatenate([*turns, self.atom_turns[self.rows]])
+        rotor_of = np.concatenate([*rotors, self.atom_rotor[self.rows]])
         self.moving = np.flatnonzero(owner >= 0)
         self.moving_body = owner[self.moving]
-        self.turning = np.flatnonzero(carbonyl)
-        self.turning_body = owner[self.turning]
+        self.turning = np.flatnonzero(rotor_of != NO_ROTOR)
+        self.turning_body, self.turning_rotor = owner[self.turning], rotor_of[self.turning]
         # the two sides of the vector rows (3 per term) and distance terms: points, bodies, carbonyl or not
         side_a = np.concatenate([np.repeat(vector_a, 3), self.distance_a])
         side_b = np.concatenate([np.repeat(vector_b, 3), self.distance_b])
-        self.sides = tuple((side, owner[side], carbonyl[side]) for side in (side_a, side_b))
+        self.sides = tuple((side, owner[side], rotor_of[side]) for side in (side_a, side_b))
         self.vector_direction = weights.reshape(-1, 3)
 
     def _ramachandran_terms(self, residues: np.ndarray, body_of: np.ndarray, reference: np.ndarray) -> None:
@@ -369,8 +397,9 @@ class _Problem:
     def place(self, state: _State) -> np.ndarray:
         """Positions at ``state`` of the term points, then of the atoms of the free residues."""
         out = self.start.copy()
-        k = self.turning_body
-        out[self.turning] = self.pivot[k] + _turned(out[self.turning] - self.pivot[k], self.axis[k], state.psi[k])
+        k, on = self.turning_body, self.turning_rotor
+        pivot = self.pivot[k, on]
+        out[self.turning] = pivot + _turned(out[self.turning] - pivot, self.axis[k, on], state.turn[k, on])
         b = self.moving_body
         centre = self.centre[b]
         turned = np.einsum("aij,aj->ai", state.rotation[b], out[self.moving] - centre)
@@ -411,7 +440,7 @@ class _Problem:
         i = np.concatenate([self.free_atoms[inner[:, 0]], self.free_atoms[outer["i"]]])
         j = np.concatenate([self.free_atoms[inner[:, 1]], self.surroundings[outer["j"]]])
         i, j = np.minimum(i, j), np.maximum(i, j)
-        keep = (self.atom_body[i] != self.atom_body[j]) | (self.atom_turns[i] != self.atom_turns[j])  # O turns
+        keep = (self.atom_body[i] != self.atom_body[j]) | (self.atom_rotor[i] != self.atom_rotor[j])
         i, j = self.top.screen(current, i[keep], j[keep], reach - SKIN)
         contact = self.top.contact(i, j)
         self.candidate_i, self.candidate_j, self.candidate_limit = i, j, contact - reach
@@ -452,44 +481,52 @@ class _Problem:
         rama, rama_direction, outer = self.ramachandran(current)
         residual = np.concatenate([vector_residual, value[:n_distance] / sigma[:n_distance], rama,
                                    value[n_distance:] / sigma[n_distance:]])
-        no_turn = np.zeros(len(outer), dtype=bool)
+        no_turn = np.full(len(outer), NO_ROTOR)
         sides = tuple(
             (np.concatenate([x[points], outer, current[atoms]]),
              np.concatenate([owner, rama_owner, self.atom_body[atoms]]),
-             np.concatenate([turns, no_turn, self.atom_turns[atoms]]))
-            for (points, owner, turns), rama_owner, atoms in zip(self.sides, self.rama_owners, (i, j))
+             np.concatenate([on, no_turn, self.atom_rotor[atoms]]))
+            for (points, owner, on), rama_owner, atoms in zip(self.sides, self.rama_owners, (i, j))
         )
         direction = np.concatenate([self.vector_direction, unit[:n_distance], rama_direction, unit[n_distance:]])
         return residual, (*sides, direction, state)
 
     def jacobian(self, terms: tuple) -> sparse.csr_matrix:
-        """The Jacobian of the residuals with respect to (δt, δω, δψ) of every body.
+        """The Jacobian of the residuals with respect to (δt, δω, δψ, δχ1) of every body.
 
         To first order each residual is ``d . x_b - d . x_a``, and for a point ``x`` of a
-        body with Cα at ``c`` and carbonyl axis ``a`` through its C at ``p``
-        ``d(d . x)/d(δt, δω, δψ) = (d, (x - c) x d, a . ((x - p) x d))``, the last for
-        carbonyl points only. Each row has the 7 entries of each moving side.
+        body with Cα at ``c``, turned by a rotor of axis ``a`` through ``p``,
+        ``d(d . x)/d(δt, δω, δturn) = (d, (x - c) x d, a . ((x - p) x d))``, the last in the
+        column of that rotor only. Each row has the entries of each moving side.
         """
-        (xa, oa, ta), (xb, ob, tb), direction, state = terms
+        (xa, oa, ra), (xb, ob, rb), direction, state = terms
         centre = self.centre + state.shift
-        axis = np.einsum("bij,bj->bi", state.rotation, self.axis)
-        pivot = centre + np.einsum("bij,bj->bi", state.rotation, self.pivot - self.centre)
+        axis = np.einsum("bij,brj->bri", state.rotation, self.axis)
+        pivot = centre[:, None] + np.einsum("bij,brj->bri", state.rotation, self.pivot - self.centre[:, None])
         n = len(direction)
-        xyz, owner, turns = np.concatenate([xa, xb]), np.concatenate([oa, ob]), np.concatenate([ta, tb])
-        body = owner.clip(min=0)
+        xyz, owner, on = np.concatenate([xa, xb]), np.concatenate([oa, ob]), np.concatenate([ra, rb])
+        body, rotor = owner.clip(min=0), on.clip(min=0)
         both = np.concatenate([-direction, direction])  # x_a enters with a minus sign
         block = np.empty((2 * n, PARAMETERS))
         block[:, :3] = both
         block[:, 3:6] = _cross(xyz - centre[body], both)
-        block[:, 6] = np.einsum("ij,ij->i", axis[body], _cross(xyz - pivot[body], both))
+        block[:, 6:] = np.einsum("ij,ij->i", axis[body, rotor], _cross(xyz - pivot[body, rotor], both))[:, None]
         mask = np.repeat((owner >= 0)[:, None], PARAMETERS, axis=1)
-        mask[:, 6] &= turns
+        mask[:, 6:] &= on[:, None] == np.arange(ROTORS)  # (where a body has a rotor, it has its column)
         # row k of the Jacobian: the entries of side a, then of side b
         mask = mask.reshape(2, n, PARAMETERS).transpose(1, 0, 2)
         data = block.reshape(2, n, PARAMETERS).transpose(1, 0, 2)[mask]
-        columns = (PARAMETERS * body[:, None] + np.arange(PARAMETERS)).reshape(2, n, PARAMETERS).transpose(1, 0, 2)
+        columns = self.column[body].reshape(2, n, PARAMETERS).transpose(1, 0, 2)
         indptr = np.concatenate([[0], np.cumsum(mask.sum(axis=(1, 2)))])
-        return sparse.csr_matrix((data, columns[mask], indptr), shape=(n, PARAMETERS * self.n_bodies))
+        return sparse.csr_matrix((data, columns[mask], indptr), shape=(n, self.n_columns))
+
+    def per_body(self, step: np.ndarray) -> np.ndarray:
+        """(m, PARAMETERS) parameters of every body from the unknowns ``step`` (0 for rotors
+        a body lacks)."""
+        out = np.zeros((self.n_bodies, PARAMETERS))
+        present = self.column >= 0
+        out[present] = step[self.column[present]]
+        return out
 
     def solve(self) -> Relaxation:
         """Levenberg–Marquardt from the start positions."""
@@ -501,14 +538,15 @@ class _Problem:
         iterations = 0
         for iterations in range(1, MAX_ITERATIONS + 1):
             step = -_solve_normal(jacobian, residual, damping)
-            per_body = step.reshape(-1, PARAMETERS)
+            per_body = self.per_body(step)
             reach = max(np.abs(per_body[:, :3]).max() / STEP_SHIFT,
                         np.abs(per_body[:, 3:]).max() / np.radians(STEP_TURN))
             limited = reach > 1.0
             if limited:
                 step /= reach
+                per_body /= reach
             predicted = cost - 0.5 * np.sum((residual + jacobian @ step) ** 2)
-            trial = state.moved(step)
+            trial = state.moved(per_body)
             trial_residual, terms = self.evaluate(trial)
             trial_cost = 0.5 * trial_residual @ trial_residual
             if trial_cost < cost:
@@ -522,7 +560,8 @@ class _Problem:
             else:
                 damping *= growth
                 growth *= 2
-        return Relaxation(self.rows, self.atoms(state)[self.rows].copy(), iterations, float(cost))
+        return Relaxation(self.rows, self.atoms(state)[self.rows].copy(), iterations, float(cost),
+                          not self.violated(residual))
 
 
 def _solve_normal(jacobian: sparse.csr_matrix, residual: np.ndarray, damping: float) -> np.ndarray:
@@ -534,13 +573,9 @@ def _solve_normal(jacobian: sparse.csr_matrix, residual: np.ndarray, damping: fl
     """
     normal = (jacobian.T @ jacobian).tocsc()  # symmetric: its CSR arrays are its CSC arrays
     column = np.repeat(np.arange(normal.shape[1]), np.diff(normal.indptr))
-    diagonal = np.flatnonzero(normal.indices == column)
-    if len(diagonal) == normal.shape[1]:
-        normal.data[diagonal] *= 1.0 + damping
-        normal.data[diagonal] += 1e-12 * normal.data[diagonal].max()
-    else:  # a parameter that no term moves (the ψ of a residue without O)
-        diagonal = normal.diagonal()
-        normal = (normal + sparse.diags(damping * diagonal + 1e-12 * diagonal.max() + 1e-12, format="csc")).tocsc()
+    diagonal = np.flatnonzero(normal.indices == column)  # every unknown has terms: all are there
+    normal.data[diagonal] *= 1.0 + damping
+    normal.data[diagonal] += 1e-12 * normal.data[diagonal].max()
     factor = splu(normal, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
     return factor.solve(jacobian.T @ residual)
 
@@ -597,6 +632,46 @@ def _dihedrals(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> tu
     first = -length[:, None] * n1 / np.einsum("ij,ij->i", n1, n1)[:, None]
     last = length[:, None] * n2 / np.einsum("ij,ij->i", n2, n2)[:, None]
     return angle, first, last
+
+
+def _rotors(
+    structure: Structure, coords: np.ndarray, residues: np.ndarray, atom_body: np.ndarray, bb: np.ndarray,
+    top: Topology, side_chains: bool,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rotors of the bodies: (m, ROTORS, 3) pivots and unit axes (zero where a body has
+    no such rotor), and the rotor that turns each atom (NO_ROTOR for all others).
+
+    ψ turns O and OXT about Cα–C; with ``side_chains``, χ1 turns everything beyond Cβ about
+    Cα–Cβ for side chains that overlap another atom by more than CLASH_TARGET at the start
+    (not proline, whose ring closes on N): only those need to move, and each rotor costs
+    an unknown."""
+    n = len(residues)
+    names = structure.atoms.name
+    atom_rotor = np.full(len(coords), NO_ROTOR)
+    rows = np.flatnonzero(atom_body >= 0)
+    beta = np.full(n, -1)
+    is_beta = names[rows] == "CB"
+    beta[atom_body[rows[is_beta]]] = rows[is_beta]
+    bonds = np.stack([bb[residues, 2], beta], axis=1)  # the far atom of each rotor's bond
+    bonds[structure.atoms.resname[bb[residues, 1]] == "PRO", CHI1] = -1
+    body = atom_body[rows]
+    carbonyl = np.isin(names[rows], ("O", "OXT"))
+    side_chain = ~np.isin(names[rows], _MAIN_CHAIN) & top.checked[rows]
+    clashing = np.unique(np.concatenate(top.close_pairs(coords, rows[side_chain & side_chains], CLASH_TARGET)))
+    has = bonds >= 0
+    has[:, PSI] &= np.isin(np.arange(n), body[carbonyl])
+    has[:, CHI1] &= np.isin(np.arange(n), atom_body[clashing[np.isin(clashing, rows[side_chain])]])
+    centre = coords[bb[residues, 1]]
+    pivot = np.where(has[..., None], coords[bonds], centre[:, None])
+    axis = np.zeros((n, ROTORS, 3))
+    axis[has] = _unit(pivot[has] - np.broadcast_to(centre[:, None], pivot.shape)[has])
+    atom_rotor[rows[carbonyl & has[body, PSI]]] = PSI
+    atom_rotor[rows[~np.isin(names[rows], _MAIN_CHAIN) & has[body, CHI1]]] = CHI1
+    return pivot, axis, atom_rotor
+
+
+_MAIN_CHAIN = ("N", "CA", "C", "O", "OXT", "CB", "H", "H1", "H2", "H3", "HA", "HA2", "HA3", "HN", "HXT")
+"""Atom names that χ1 leaves in place (Cβ lies on its axis)."""
 
 
 def _off_axis(points: np.ndarray, through: np.ndarray, axis: np.ndarray) -> np.ndarray:

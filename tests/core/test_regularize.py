@@ -127,29 +127,37 @@ def test_regularized_edit_is_one_exact_undo_step(ubiquitin):
     assert np.array_equal(model.coords, ubiquitin.coords)
 
 
-def test_residues_keep_their_geometry_and_turn_only_psi(ubiquitin):
+def test_residues_keep_their_geometry_and_turn_only_about_two_bonds(ubiquitin):
     """Each residue moves rigidly but for its carbonyl O, which turns about the Cα–C bond
-    (ψ): every bond length and angle of the residue stays as it was."""
+    (ψ), and, where it clashes, its side chain beyond Cβ, which turns about Cα–Cβ (χ1):
+    every bond length and angle of the residue stays as it was. This inward edit still
+    clashes once the backbone alone has settled, so side chains turn too."""
     model = EditableModel(ubiquitin)
-    fixed = regularized(model, outward_edit(model, 3, 4))
+    edit = outward_edit(model, 5, 9, distance=-5.0)
+    edited = coords_after(model, edit)
+    fixed = regularized(model, edit)
     after = coords_after(model, fixed)
     segment, atoms = ubiquitin.segments[0], ubiquitin.atoms
     pairwise = lambda x: np.linalg.norm(x[:, None] - x[None], axis=-1)  # noqa: E731
-    turned = []
+    turned = {"psi": 0.0, "chi1": 0.0}
     for residue in fixed.residues:
         rows = np.arange(segment.atom_start[residue], segment.atom_stop[residue])
-        carbonyl = np.isin(atoms.name[rows], ("O", "OXT"))
-        body = rows[~carbonyl]
-        assert np.abs(pairwise(after[body]) - pairwise(ubiquitin.coords[body])).max() < 1e-9
-        ca, c = (rows[atoms.name[rows] == name][0] for name in ("CA", "C"))
-        for o in rows[carbonyl]:  # the O–C bond and the Cα–C–O angle (the O–Cα distance)
-            for partner in (c, ca):
-                before = np.linalg.norm(ubiquitin.coords[o] - ubiquitin.coords[partner])
-                assert abs(np.linalg.norm(after[o] - after[partner]) - before) < 1e-9
-        frame = rows[np.isin(atoms.name[rows], ("N", "CA", "C"))]
-        rotation, shift = kabsch(ubiquitin.coords[frame], after[frame])
-        turned.append(max(np.linalg.norm(rotation @ ubiquitin.coords[o] + shift - after[o]) for o in rows[carbonyl]))
-    assert max(turned) > 0.05  # ψ did change somewhere
+        names = atoms.name[rows]
+        carbonyl = np.isin(names, ("O", "OXT"))
+        side_chain = ~np.isin(names, ("N", "CA", "C", "O", "OXT", "CB"))
+        frame = rows[~carbonyl & ~side_chain]
+        for group, axis in ((frame, ()), (rows[carbonyl], ("CA", "C")), (rows[side_chain], ("CA", "CB"))):
+            if len(group) == 0:
+                continue
+            ends = np.array([rows[names == name][0] for name in axis], dtype=int)  # on the bond it turns about
+            together = np.concatenate([group, ends])
+            assert np.abs(pairwise(after[together]) - pairwise(ubiquitin.coords[together])).max() < 1e-9
+        rotation, shift = kabsch(edited[frame], after[frame])
+        for key, group in (("psi", rows[carbonyl]), ("chi1", rows[side_chain])):
+            if len(group):
+                moved = np.linalg.norm(edited[group] @ rotation.T + shift - after[group], axis=1).max()
+                turned[key] = max(turned[key], moved)
+    assert turned["psi"] > 0.05 and turned["chi1"] > 0.05  # both kinds of turn were used
 
 
 def test_regularize_region_after_a_plain_edit(ubiquitin):
@@ -215,7 +223,7 @@ def test_analytic_jacobian_matches_finite_differences(ubiquitin, turn):
     outliers, whose rows are zero elsewhere)."""
     from scipy.spatial.transform import Rotation
 
-    from core.regularize import PARAMETERS, _Problem, _State
+    from core.regularize import CHI1, PSI, _Problem, _State
 
     model = EditableModel(ubiquitin)
     edit = outward_edit(model, 4, 8)
@@ -224,16 +232,18 @@ def test_analytic_jacobian_matches_finite_differences(ubiquitin, turn):
     u = ribbon.residue_u[edit.residues]
     problem = _Problem(ubiquitin, coords, segment.residue_index[edit.residues],
                        ribbon.space.evaluate(edit.new_points, u), ribbon.space.evaluate(edit.new_points, u, 1),
-                       ubiquitin.coords)
+                       ubiquitin.coords, side_chains=True)
     rng = np.random.default_rng(5)
     n = problem.n_bodies
     state = _State(Rotation.from_rotvec(rng.normal(scale=turn, size=(n, 3))).as_matrix(),
-                   rng.normal(scale=0.1, size=(n, 3)), rng.normal(scale=0.2, size=n))
+                   rng.normal(scale=0.1, size=(n, 3)), rng.normal(scale=0.2, size=(n, 2)))
     residual, terms = problem.evaluate(state)
     analytic = problem.jacobian(terms).toarray()
     pairs, _, _ = problem.clash_pairs(problem.atoms(state))
     assert len(pairs) > 10  # clash terms are part of the check
-    assert np.abs(analytic[:, PARAMETERS - 1 :: PARAMETERS]).max() > 1.0  # and so are the carbonyl turns
+    for rotor in (PSI, CHI1):  # and so are the turns of the carbonyls and (clashing) side chains
+        columns = problem.column[:, 6 + rotor]
+        assert np.abs(analytic[:, columns[columns >= 0]]).max() > 1.0
     rama, _, _ = problem.ramachandran(problem.atoms(state))
     assert np.count_nonzero(rama) > (5 if turn > 0.1 else -1)
     h = 1e-6
@@ -241,6 +251,6 @@ def test_analytic_jacobian_matches_finite_differences(ubiquitin, turn):
     for column in range(analytic.shape[1]):
         step = np.zeros(analytic.shape[1])
         step[column] = h
-        moved, _ = problem.evaluate(state.moved(step))
+        moved, _ = problem.evaluate(state.moved(problem.per_body(step)))
         numeric[:, column] = (moved - residual) / h
     assert np.abs(analytic - numeric).max() < 1e-3 * np.abs(analytic).max()
