@@ -634,6 +634,10 @@ def _dihedrals(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> tu
     return angle, first, last
 
 
+_MAIN_CHAIN = ("N", "CA", "C", "O", "OXT", "CB", "H", "H1", "H2", "H3", "HA", "HA2", "HA3", "HN", "HXT")
+"""Atom names that χ1 leaves in place (Cβ lies on its axis)."""
+
+
 def _rotors(
     structure: Structure, coords: np.ndarray, residues: np.ndarray, atom_body: np.ndarray, bb: np.ndarray,
     top: Topology, side_chains: bool,
@@ -668,10 +672,6 @@ def _rotors(
     atom_rotor[rows[carbonyl & has[body, PSI]]] = PSI
     atom_rotor[rows[~np.isin(names[rows], _MAIN_CHAIN) & has[body, CHI1]]] = CHI1
     return pivot, axis, atom_rotor
-
-
-_MAIN_CHAIN = ("N", "CA", "C", "O", "OXT", "CB", "H", "H1", "H2", "H3", "HA", "HA2", "HA3", "HN", "HXT")
-"""Atom names that χ1 leaves in place (Cβ lies on its axis)."""
 
 
 def _off_axis(points: np.ndarray, through: np.ndarray, axis: np.ndarray) -> np.ndarray:
