@@ -58,7 +58,7 @@ from .model import Edit, EditableModel
 from .structure import Structure
 from .validation import (
     C_N, C_N_CA, C_N_CA_PRO, C_N_PRO, CA_C_N, CA_C_N_PRO, CA_CA_CIS, CA_CA_TRANS, CLASH_OVERLAP, OUTLIER,
-    Topology, dihedral, distance, nearest_allowed, ramachandran_region, topology,
+    Topology, distance, nearest_allowed, ramachandran_region, topology,
 )  # fmt: skip
 
 FLANK = 3
@@ -310,12 +310,12 @@ class _Problem:
         k = np.flatnonzero((body_of[top.first] >= 0) | (body_of[top.second] >= 0))
         first, second = top.first[k], top.second[k]
         full = (bb[first, 1:4] >= 0).all(axis=1) & (bb[second, :2] >= 0).all(axis=1)
-        f, s = first[full], second[full]
-        ideal_n, ideal_ca = _ideal_next(coords, bb[f], bb[s], top.cis[k[full]], top.proline[k[full]])
+        before, after = first[full], second[full]
+        ideal_n, ideal_ca = _ideal_next(coords, bb[before], bb[after], top.cis[k[full]], top.proline[k[full]])
         stiff = np.eye(3) / JUNCTION_SIGMA
-        coincide((ideal_n, body_of[f], PSI), (coords[bb[s, 0]], body_of[s]), stiff)
-        coincide((ideal_ca, body_of[f], PSI), (coords[bb[s, 1]], body_of[s]), stiff)
-        self.n_junction_rows = 6 * len(f)  # the first rows: N and Cα of the next residue, 3 each
+        coincide((ideal_n, body_of[before], PSI), (coords[bb[after, 0]], body_of[after]), stiff)
+        coincide((ideal_ca, body_of[before], PSI), (coords[bb[after, 1]], body_of[after]), stiff)
+        self.n_junction_rows = 6 * len(before)  # the first rows: N and Cα of the next residue, 3 each
         f, s = first[~full], second[~full]  # Cα only: keep the Cα–Cα distance
         self.distance_a = add(coords[bb[f, 1]], body_of[f])
         self.distance_b = add(coords[bb[s, 1]], body_of[s])
@@ -335,12 +335,11 @@ class _Problem:
             atom = coords[rows[first_row]]
             radius = _off_axis(atom, self.pivot[body, on], self.axis[body, on])
             coincide((atom, body), (atom, body, on), _torsion_weights(radius))
-        f, s = first[full], second[full]
-        carbon = coords[bb[s, 2]]
-        ok = bb[s, 2] >= 0
-        f, s, carbon = f[ok], s[ok], carbon[ok]
-        radius = _off_axis(carbon, coords[bb[s, 1]], _unit(coords[bb[s, 1]] - coords[bb[s, 0]]))
-        coincide((carbon, body_of[f], PSI), (carbon, body_of[s]), _torsion_weights(radius))
+        ok = bb[after, 2] >= 0
+        before, after = before[ok], after[ok]
+        carbon = coords[bb[after, 2]]
+        radius = _off_axis(carbon, coords[bb[after, 1]], _unit(coords[bb[after, 1]] - coords[bb[after, 0]]))
+        coincide((carbon, body_of[before], PSI), (carbon, body_of[after]), _torsion_weights(radius))
         vector_a, vector_b, weights = (np.concatenate(t) for t in zip(*vector_terms))
         self.vector_a, self.vector_b, self.vector_weights = vector_a, vector_b, weights
         self.n_vector_rows = 3 * len(vector_a)
@@ -353,7 +352,7 @@ class _Problem:
         self.moving_body = owner[self.moving]
         self.turning = np.flatnonzero(rotor_of != NO_ROTOR)
         self.turning_body, self.turning_rotor = owner[self.turning], rotor_of[self.turning]
-        # the two sides of the vector rows (3 per term) and distance terms: points, bodies, carbonyl or not
+        # the two sides of the vector rows (3 per term) and distance terms: points, bodies, rotors
         side_a = np.concatenate([np.repeat(vector_a, 3), self.distance_a])
         side_b = np.concatenate([np.repeat(vector_b, 3), self.distance_b])
         self.sides = tuple((side, owner[side], rotor_of[side]) for side in (side_a, side_b))
@@ -373,8 +372,9 @@ class _Problem:
         chain = np.column_stack([c_before, bb[residues, :3], n_after])
         kind = top.rama_class[residues]
         p = reference[chain].transpose(1, 0, 2)
-        with np.errstate(invalid="ignore"):
-            region = ramachandran_region(dihedral(*p[:4]), dihedral(*p[1:]), kind)
+        with np.errstate(invalid="ignore", divide="ignore"):  # rows with a missing atom are dropped below
+            angles = np.degrees([_dihedrals(*p[:4])[0], _dihedrals(*p[1:])[0]])
+        region = ramachandran_region(np.nan_to_num(angles[0]), np.nan_to_num(angles[1]), kind)
         k = np.flatnonzero((chain >= 0).all(axis=1) & (region != OUTLIER))
         self.rama_atoms, self.rama_kind = chain[k], kind[k]
         self.rama_owners = np.concatenate([k, k]), np.concatenate([body_of[prev[k]], body_of[next_[k]]])
