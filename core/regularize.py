@@ -95,13 +95,12 @@ SKIN = 2.0
 again once a free atom has moved SKIN / 2 (a Verlet list)."""
 DAMPING = 1e-2
 """Initial Levenberg–Marquardt damping, relative to the diagonal."""
-TOLERANCE = 0.1
-"""Stop when no junction, residue or clash would be flagged and a step is predicted to
-lower the objective by less than this fraction."""
 STALL = 3e-3
-"""Stop anyway when a step is predicted to lower the objective by less than this fraction."""
-MAX_ITERATIONS = 40
-"""Levenberg–Marquardt steps at most (typically 6–15 are taken)."""
+"""Stop when nothing would be flagged, or anyway when a step is predicted to lower the
+objective by less than this fraction."""
+MAX_ITERATIONS = 25
+"""Levenberg–Marquardt steps at most per fit (typically 4–12 are taken; edits that have
+not settled by then are over-constrained, and more steps rarely remove a flag)."""
 STEP_SHIFT = 1.0
 """Å; no step shifts a body farther, ..."""
 STEP_TURN = 20.0
@@ -416,7 +415,7 @@ class _Problem:
         """Pairs with a free atom within CLASH_MARGIN of clashing, and the distance each
         should keep: its contact distance less CLASH_TARGET, or its distance before."""
         moving = current[self.free_atoms]
-        if self.listed_at is None or np.max(np.abs(moving - self.listed_at)) > SKIN / 2:
+        if self.listed_at is None or _moved_beyond(moving, self.listed_at, SKIN / 2):
             self._list_candidates(current)
         i, j = self.candidate_i, self.candidate_j
         near = distance(current[i], current[j]) < self.candidate_limit
@@ -533,11 +532,12 @@ class _Problem:
         state = _State.start(self.n_bodies)
         residual, terms = self.evaluate(state)
         jacobian = self.jacobian(terms)
+        normal = _Normal(jacobian)
         cost = 0.5 * residual @ residual
         damping, growth = DAMPING, 2.0
         iterations = 0
         for iterations in range(1, MAX_ITERATIONS + 1):
-            step = -_solve_normal(jacobian, residual, damping)
+            step = -normal.solve(jacobian.T @ residual, damping)
             per_body = self.per_body(step)
             reach = max(np.abs(per_body[:, :3]).max() / STEP_SHIFT,
                         np.abs(per_body[:, 3:]).max() / np.radians(STEP_TURN))
@@ -551,33 +551,44 @@ class _Problem:
             trial_cost = 0.5 * trial_residual @ trial_residual
             if trial_cost < cost:
                 gain = (cost - trial_cost) / max(predicted, 1e-300)
-                state, residual, jacobian, cost = trial, trial_residual, self.jacobian(terms), trial_cost
+                state, residual, cost = trial, trial_residual, trial_cost
+                jacobian = self.jacobian(terms)
+                normal = _Normal(jacobian)
                 damping = max(damping * max(1 / 3, 1 - (2 * gain - 1) ** 3), 1e-7)
                 growth = 2.0
-                converged = predicted < STALL * cost or (predicted < TOLERANCE * cost and not self.violated(residual))
-                if converged and not limited:
+                if not self.violated(residual) and not limited or predicted < STALL * cost:
                     break
-            else:
+            else:  # the same normal matrix, damped more
                 damping *= growth
                 growth *= 2
         return Relaxation(self.rows, self.atoms(state)[self.rows].copy(), iterations, float(cost),
                           not self.violated(residual))
 
 
-def _solve_normal(jacobian: sparse.csr_matrix, residual: np.ndarray, damping: float) -> np.ndarray:
-    """Solve the damped normal equations ``(J^T J + λ D) δ = J^T r`` (D its diagonal).
+class _Normal:
+    """The normal matrix ``J^T J`` of a Jacobian, to solve ``(J^T J + λ D) δ = g`` for
+    several dampings λ (D its diagonal).
 
     Bodies are residues in chain order: junctions couple neighbouring bodies and most
     clash pairs residues a few apart, so the matrix is sparse and nearly banded; SuperLU
     (a fill-reducing order, no pivoting: it is positive definite) factors it in O(m).
     """
-    normal = (jacobian.T @ jacobian).tocsc()  # symmetric: its CSR arrays are its CSC arrays
-    column = np.repeat(np.arange(normal.shape[1]), np.diff(normal.indptr))
-    diagonal = np.flatnonzero(normal.indices == column)  # every unknown has terms: all are there
-    normal.data[diagonal] *= 1.0 + damping
-    normal.data[diagonal] += 1e-12 * normal.data[diagonal].max()
-    factor = splu(normal, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-    return factor.solve(jacobian.T @ residual)
+
+    def __init__(self, jacobian: sparse.csr_matrix) -> None:
+        self.matrix = (jacobian.T @ jacobian).tocsc()  # symmetric: its CSR arrays are its CSC arrays
+        self.matrix.sum_duplicates()  # sorted indices (splu would sort the arrays in place)
+        column = np.repeat(np.arange(self.matrix.shape[1]), np.diff(self.matrix.indptr))
+        self.diagonal = np.flatnonzero(self.matrix.indices == column)  # every unknown has terms: all are there
+        self.values = self.matrix.data.copy()
+
+    def solve(self, gradient: np.ndarray, damping: float) -> np.ndarray:
+        """``δ`` for the damping ``damping`` (λ)."""
+        data = self.matrix.data
+        data[:] = self.values
+        data[self.diagonal] *= 1.0 + damping
+        data[self.diagonal] += 1e-12 * data[self.diagonal].max()
+        factor = splu(self.matrix, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+        return factor.solve(gradient)
 
 
 def _normal_planes(along: np.ndarray) -> np.ndarray:
@@ -609,6 +620,11 @@ def _ideal_next(
     side = np.where(cis, 1.0, -1.0)[:, None]  # trans: the next Cα opposite the previous one
     next_ca = n + n_ca[:, None] * (np.cos(c_n_ca)[:, None] * e + side * np.sin(c_n_ca)[:, None] * towards_ca)
     return n, next_ca
+
+
+def _moved_beyond(now: np.ndarray, then: np.ndarray, limit: float) -> bool:
+    """Whether any point of ``now`` (k, 3) is farther than ``limit`` from where it was in ``then``."""
+    return bool(np.max(np.einsum("ij,ij->i", now - then, now - then)) > limit * limit)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

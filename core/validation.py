@@ -284,7 +284,8 @@ class Topology:
         if rows is None:
             pairs = cKDTree(coords[atoms]).query_pairs(cutoff, output_type="ndarray")
             return self.screen(coords, atoms[pairs[:, 0]], atoms[pairs[:, 1]], reach)
-        rows = np.intersect1d(rows, atoms)
+        rows = np.unique(rows)
+        rows = rows[self.checked[rows]]
         if len(rows) == 0:
             return rows, rows
         low, high = coords[rows].min(axis=0) - cutoff, coords[rows].max(axis=0) + cutoff
