@@ -58,7 +58,7 @@ from .model import Edit, EditableModel
 from .structure import Structure
 from .validation import (
     C_N, C_N_CA, C_N_CA_PRO, C_N_PRO, CA_C_N, CA_C_N_PRO, CA_CA_CIS, CA_CA_TRANS, CLASH_OVERLAP, OUTLIER,
-    Topology, distance, nearest_allowed, ramachandran_region, topology,
+    Topology, distance, lengths, nearest_allowed, ramachandran_region, topology,
 )  # fmt: skip
 
 FLANK = 3
@@ -273,7 +273,7 @@ class _Problem:
 
     def __init__(self, structure: Structure, coords: np.ndarray, residues: np.ndarray,
                  anchors: np.ndarray, tangents: np.ndarray, reference: np.ndarray, side_chains: bool) -> None:
-        self.top = top = topology(structure)
+        top = topology(structure)
         self.reference = reference
         self.n_bodies = n = len(residues)
         bb = top.backbone
@@ -281,6 +281,7 @@ class _Problem:
         body_of[residues] = np.arange(n)
         self.atom_body = np.where(structure.atom_residue >= 0, body_of[structure.atom_residue.clip(min=0)], -1)
         self.rows = np.flatnonzero(self.atom_body >= 0)
+        self.top = top = top.around(self.rows)  # every clash pair has a free atom
         self.centre = coords[bb[residues, 1]]
         self.pivot, self.axis, self.atom_rotor = _rotors(structure, coords, residues, self.atom_body, bb, top, side_chains)
         rotor = np.any(self.axis != 0, axis=2)  # (n, ROTORS): which bodies have which rotor
@@ -470,7 +471,7 @@ class _Problem:
         pair_a = np.concatenate([x[self.distance_a], current[i]])
         vector = np.concatenate([x[self.distance_b], current[j]]) - pair_a
         sigma = np.concatenate([np.full(n_distance, JUNCTION_SIGMA), np.full(len(i), CLASH_SIGMA)])
-        length = np.linalg.norm(vector, axis=1)
+        length = lengths(vector)
         gap = length - np.concatenate([self.distance_d0, d_min])
         value, slope = gap.copy(), np.ones(len(gap))
         z = -gap[n_distance:] / CLASH_SOFTNESS
@@ -595,7 +596,7 @@ def _normal_planes(along: np.ndarray) -> np.ndarray:
     """(m, 2, 3) two unit vectors perpendicular to each unit vector of ``along`` (m, 3)."""
     helper = np.eye(3)[np.argmin(np.abs(along), axis=1)]
     first = _cross(along, helper)
-    first /= np.linalg.norm(first, axis=1, keepdims=True)
+    first /= lengths(first)[:, None]
     return np.stack([first, _cross(along, first)], axis=1)
 
 
@@ -628,7 +629,7 @@ def _moved_beyond(now: np.ndarray, then: np.ndarray, limit: float) -> bool:
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v, axis=1, keepdims=True)
+    return v / lengths(v)[:, None]
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -643,7 +644,7 @@ def _dihedrals(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> tu
     :func:`core.validation.dihedral`) and their gradients (per Å) with respect to a and d."""
     b1, b2, b3 = b - a, c - b, d - c
     n1, n2 = _cross(b1, b2), _cross(b2, b3)
-    length = np.linalg.norm(b2, axis=1)
+    length = lengths(b2)
     angle = np.arctan2(length * np.einsum("ij,ij->i", b1, n2), np.einsum("ij,ij->i", n1, n2))
     first = -length[:, None] * n1 / np.einsum("ij,ij->i", n1, n1)[:, None]
     last = length[:, None] * n2 / np.einsum("ij,ij->i", n2, n2)[:, None]
@@ -693,7 +694,7 @@ def _rotors(
 def _off_axis(points: np.ndarray, through: np.ndarray, axis: np.ndarray) -> np.ndarray:
     """Distances (Å) of ``points`` from the lines through ``through`` along unit ``axis`` (all (k, 3))."""
     arm = points - through
-    return np.linalg.norm(arm - np.einsum("ij,ij->i", arm, axis)[:, None] * axis, axis=1)
+    return lengths(arm - np.einsum("ij,ij->i", arm, axis)[:, None] * axis)
 
 
 def _torsion_weights(radius: np.ndarray) -> np.ndarray:

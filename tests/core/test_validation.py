@@ -1,5 +1,6 @@
 """Geometry validation against independent computations (gemmi, brute force) on real entries."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import gemmi
@@ -185,6 +186,21 @@ def test_clashes_agree_with_brute_force(ubiquitin):
     assert report.counts["clash"] == len(expected)
     overlaps = sorted((f.severity for f in report.flags if f.kind == "clash"), reverse=True)
     assert report.worst(1, "clash")[0].severity == overlaps[0] > 1
+
+
+def test_a_topology_around_some_atoms_screens_their_pairs_like_the_whole():
+    structure = read_structure(DATA / "1BPI.pdb.gz")  # disulfides 5-55, 14-38, 30-51
+    top = topology(structure)
+    rows = np.flatnonzero(np.isin(structure.atom_residue, np.arange(49, 56)))  # Cys51, Cys55: partners before
+    local = top.around(rows)
+    assert 0 < len(local.excluded) < len(top.excluded) / 5
+    for reach in (-2.0, -0.5):  # near pairs; bonded ones among them must be excluded
+        expected = top.close_pairs(structure.coords, rows, reach)
+        got = local.close_pairs(structure.coords, rows, reach)
+        assert len(expected[0]) > 0
+        np.testing.assert_array_equal(np.sort(got[0] * top.n_atoms + got[1]), np.sort(expected[0] * top.n_atoms + expected[1]))
+    unscreened = replace(local, excluded=local.excluded[:0]).close_pairs(structure.coords, rows, -2.0)
+    assert len(unscreened[0]) > len(top.close_pairs(structure.coords, rows, -2.0)[0])
 
 
 def test_hydrogens_waters_and_other_conformers_never_clash():
