@@ -99,7 +99,7 @@ STALL = 3e-3
 """Stop when nothing would be flagged, or anyway when a step is predicted to lower the
 objective by less than this fraction."""
 MAX_ITERATIONS = 25
-"""Levenberg–Marquardt steps at most per fit (typically 4–12 are taken; edits that have
+"""Levenberg–Marquardt steps at most per fit (typically 4–14 are taken; edits that have
 not settled by then are over-constrained, and more steps rarely remove a flag)."""
 STEP_SHIFT = 1.0
 """Å; no step shifts a body farther, ..."""
