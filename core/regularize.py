@@ -557,7 +557,7 @@ class _Problem:
                 normal = _Normal(jacobian)
                 damping = max(damping * max(1 / 3, 1 - (2 * gain - 1) ** 3), 1e-7)
                 growth = 2.0
-                if not self.violated(residual) and not limited or predicted < STALL * cost:
+                if not limited and (not self.violated(residual) or predicted < STALL * cost):
                     break
             else:  # the same normal matrix, damped more
                 damping *= growth
@@ -583,7 +583,7 @@ class _Normal:
         self.values = self.matrix.data.copy()
 
     def solve(self, gradient: np.ndarray, damping: float) -> np.ndarray:
-        """``δ`` for the damping ``damping`` (λ)."""
+        """``δ`` for the damping λ = ``damping``."""
         data = self.matrix.data
         data[:] = self.values
         data[self.diagonal] *= 1.0 + damping
@@ -625,7 +625,7 @@ def _ideal_next(
 
 def _moved_beyond(now: np.ndarray, then: np.ndarray, limit: float) -> bool:
     """Whether any point of ``now`` (k, 3) is farther than ``limit`` from where it was in ``then``."""
-    return bool(np.max(np.einsum("ij,ij->i", now - then, now - then)) > limit * limit)
+    return bool(lengths(now - then).max() > limit)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
