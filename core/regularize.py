@@ -92,7 +92,7 @@ SURROUNDINGS = 4.0
 """Å: the fixed atoms near the free ones are found once, for moves up to this far."""
 SKIN = 2.0
 """Å: the clash candidates are the pairs within CLASH_MARGIN + SKIN of clashing, listed
-again once a free atom has moved SKIN / 2 (a Verlet list)."""
+again once the two free atoms that moved most have moved SKIN in all (a Verlet list)."""
 DAMPING = 1e-2
 """Initial Levenberg–Marquardt damping, relative to the diagonal."""
 STALL = 3e-3
@@ -416,14 +416,14 @@ class _Problem:
         """Pairs with a free atom within CLASH_MARGIN of clashing, and the distance each
         should keep: its contact distance less CLASH_TARGET, or its distance before."""
         moving = current[self.free_atoms]
-        if self.listed_at is None or _moved_beyond(moving, self.listed_at, SKIN / 2):
+        if self.listed_at is None or _list_expired(moving, self.listed_at):
             self._list_candidates(current)
         i, j = self.candidate_i, self.candidate_j
         near = distance(current[i], current[j]) < self.candidate_limit
         return i[near], j[near], self.candidate_d_min[near]
 
     def _list_candidates(self, current: np.ndarray) -> None:
-        """The pairs that may clash while no free atom moves more than SKIN / 2 from here
+        """The pairs that may clash until two free atoms have moved SKIN in all from here
         (a Verlet list), with their clash limit and the distance each should keep."""
         reach = CLASH_TARGET - CLASH_MARGIN
         cutoff = self.top.search_radius(reach) + SKIN
@@ -505,7 +505,7 @@ class _Problem:
         pivot = centre[:, None] + np.einsum("bij,brj->bri", state.rotation, self.pivot - self.centre[:, None])
         n = len(direction)
         xyz, owner, on = np.concatenate([xa, xb]), np.concatenate([oa, ob]), np.concatenate([ra, rb])
-        body, rotor = owner.clip(min=0), on.clip(min=0)
+        body, rotor = np.maximum(owner, 0), np.maximum(on, 0)
         both = np.concatenate([-direction, direction])  # x_a enters with a minus sign
         block = np.empty((2 * n, PARAMETERS))
         block[:, :3] = both
@@ -623,9 +623,12 @@ def _ideal_next(
     return n, next_ca
 
 
-def _moved_beyond(now: np.ndarray, then: np.ndarray, limit: float) -> bool:
-    """Whether any point of ``now`` (k, 3) is farther than ``limit`` from where it was in ``then``."""
-    return bool(lengths(now - then).max() > limit)
+def _list_expired(now: np.ndarray, then: np.ndarray) -> bool:
+    """Whether a pair left out of a Verlet list made at ``then`` (k, 3 free atoms) may have
+    come within its cutoff at ``now``: the two largest moves add up to more than SKIN (a
+    pair with a fixed atom has only one move)."""
+    moves = lengths(now - then)
+    return bool(np.partition(moves, -2)[-2:].sum() > SKIN if len(moves) > 1 else moves.sum() > SKIN)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -636,7 +639,9 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Row-wise cross products of (k, 3) arrays (``np.cross`` costs more for short arrays)."""
     a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
     b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=1)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[:, 0], out[:, 1], out[:, 2] = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    return out
 
 
 def _dihedrals(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, ...]:

@@ -254,3 +254,43 @@ def test_analytic_jacobian_matches_finite_differences(ubiquitin, turn):
         moved, _ = problem.evaluate(state.moved(problem.per_body(step)))
         numeric[:, column] = (moved - residual) / h
     assert np.abs(analytic - numeric).max() < 1e-3 * np.abs(analytic).max()
+
+
+def test_the_clash_candidate_list_misses_no_pair(ubiquitin):
+    """The Verlet list is kept while the two free atoms that moved most have moved less than
+    SKIN in all; over a walk of random steps it must give exactly the pairs a new list gives,
+    and it must be kept for some steps and made again for others."""
+    from core.regularize import SKIN, _Problem, _State
+
+    model = EditableModel(ubiquitin)
+    edit = outward_edit(model, 4, 8)
+    ribbon, segment = model.ribbons[0], ubiquitin.segments[0]
+    u = ribbon.residue_u[edit.residues]
+    problem, fresh_problem = (
+        _Problem(ubiquitin, coords_after(model, edit), segment.residue_index[edit.residues],
+                 ribbon.space.evaluate(edit.new_points, u), ribbon.space.evaluate(edit.new_points, u, 1),
+                 ubiquitin.coords, side_chains=True)
+        for _ in range(2)
+    )
+    rng = np.random.default_rng(11)
+    n = problem.n_bodies
+    state = _State.start(n)
+    kept = listed = 0
+    for _ in range(30):
+        step = np.zeros((n, 8))
+        step[:, :3] = rng.normal(scale=0.15, size=(n, 3))
+        step[:, 3:] = rng.normal(scale=0.03, size=(n, 5))
+        state = state.moved(step)
+        current = problem.atoms(state)
+        before = problem.listed_at
+        pairs = problem.clash_pairs(current)
+        kept += problem.listed_at is before
+        listed += problem.listed_at is not before
+        if problem.listed_at is before:  # the two largest moves since the list add up to less than SKIN
+            moves = np.sort(np.linalg.norm(current[problem.free_atoms] - before, axis=1))
+            assert moves[-2:].sum() <= SKIN
+        fresh_problem.listed_at = None  # a new list here
+        fresh = fresh_problem.clash_pairs(current)
+        assert {tuple(p) for p in np.column_stack(pairs[:2])} == {tuple(p) for p in np.column_stack(fresh[:2])}
+        assert np.array_equal(np.sort(pairs[2]), np.sort(fresh[2]))
+    assert kept > 3 and listed > 3
