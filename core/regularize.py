@@ -627,8 +627,7 @@ def _list_expired(now: np.ndarray, then: np.ndarray) -> bool:
     """Whether a pair left out of a Verlet list made at ``then`` (k, 3 free atoms) may have
     come within its cutoff at ``now``: the two largest moves add up to more than SKIN (a
     pair with a fixed atom has only one move)."""
-    moves = lengths(now - then)
-    return bool(np.partition(moves, -2)[-2:].sum() > SKIN if len(moves) > 1 else moves.sum() > SKIN)
+    return bool(np.sort(lengths(now - then))[-2:].sum() > SKIN)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
