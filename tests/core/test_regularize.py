@@ -260,7 +260,7 @@ def test_the_clash_candidate_list_misses_no_pair(ubiquitin):
     """The Verlet list is kept while the two free atoms that moved most have moved less than
     SKIN in all; over a walk of random steps it must give exactly the pairs a new list gives,
     and it must be kept for some steps and made again for others."""
-    from core.regularize import SKIN, _Problem, _State
+    from core.regularize import PARAMETERS, SKIN, _Problem, _State
 
     model = EditableModel(ubiquitin)
     edit = outward_edit(model, 4, 8)
@@ -277,9 +277,9 @@ def test_the_clash_candidate_list_misses_no_pair(ubiquitin):
     state = _State.start(n)
     kept = listed = 0
     for _ in range(30):
-        step = np.zeros((n, 8))
+        step = np.zeros((n, PARAMETERS))
         step[:, :3] = rng.normal(scale=0.15, size=(n, 3))
-        step[:, 3:] = rng.normal(scale=0.03, size=(n, 5))
+        step[:, 3:] = rng.normal(scale=0.03, size=(n, PARAMETERS - 3))
         state = state.moved(step)
         current = problem.atoms(state)
         before = problem.listed_at
