@@ -10,6 +10,8 @@ would be lost. The ``app`` package sets ``QT_API`` before this module imports py
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +28,7 @@ from PySide6.QtGui import (
     QPainter,
 )
 from PySide6.QtWidgets import (
+    QApplication,
     QDockWidget,
     QFileDialog,
     QLabel,
@@ -342,6 +345,8 @@ class MainWindow(QMainWindow):
             return False  # what is hidden cannot be grabbed: the press turns the camera
         if event.kind == "release" and self.controller.dragging:
             self.plotter.renderer.SetUseFXAA(True)  # the frame after the drag is a still one
+            with _busy():  # the release regularizes: a hard edit takes a few tenths of a second
+                return self.controller.handle(event)
         used = self.controller.handle(event)
         if used and event.kind == "press":
             self.plotter.renderer.SetUseFXAA(False)
@@ -355,7 +360,8 @@ class MainWindow(QMainWindow):
 
     def _regularize_region(self) -> None:
         if self.document.pick is not None:
-            self.document.regularize_region(self.document.pick.residues)
+            with _busy():
+                self.document.regularize_region(self.document.pick.residues)
 
     def _update_regularize_action(self) -> None:
         self.regularize_action.setEnabled(self.document.pick is not None)
@@ -428,3 +434,13 @@ def _scrolled(widget: QWidget) -> QScrollArea:
     area.setWidget(widget)
     area.setWidgetResizable(True)
     return area
+
+
+@contextmanager
+def _busy() -> Iterator[None]:
+    """A wait cursor while the window works without returning to the event loop."""
+    QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)
+    try:
+        yield
+    finally:
+        QApplication.restoreOverrideCursor()

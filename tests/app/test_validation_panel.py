@@ -9,6 +9,10 @@ import pytest
 from pytestqt.qtbot import QtBot
 from test_window import _display, _mouse_drag, _window
 
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QApplication
+
+from app import document as document_module
 from app import live_validation
 from app.main_window import MainWindow
 from app.scene import Layer
@@ -79,6 +83,27 @@ def test_a_drag_is_regularized_on_release_in_one_undo_step(window: MainWindow) -
     _mouse_drag(window, _press_point(window), OFFSET)
     assert document.undo_stack.count() == 1
     assert np.any(np.abs(_peptide_bonds(window) - 1.33) > 0.05)
+
+
+def test_the_cursor_waits_while_a_release_or_region_is_regularized(
+    window: MainWindow, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    cursors = []
+
+    def spy(function):
+        def called(*args, **kwargs):
+            cursor = QApplication.overrideCursor()
+            cursors.append(None if cursor is None else cursor.shape())
+            return function(*args, **kwargs)
+        return called
+
+    monkeypatch.setattr(document_module, "regularized", spy(document_module.regularized))
+    monkeypatch.setattr(document_module, "regularize_region", spy(document_module.regularize_region))
+    _mouse_drag(window, _press_point(window), OFFSET)
+    window.regularize_action.trigger()
+    assert cursors == [Qt.CursorShape.WaitCursor, Qt.CursorShape.WaitCursor]
+    assert QApplication.overrideCursor() is None  # restored afterwards
+    assert window.document.undo_stack.count() == 2
 
 
 def test_regularize_while_dragging_shows_regular_previews(window: MainWindow, qtbot: QtBot) -> None:
