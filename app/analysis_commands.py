@@ -42,7 +42,7 @@ from core.analysis import (
     analyse_path,
     rms_crossing,
 )
-from core.compare import Comparison, compare_chains
+from core.compare import PAIRINGS, Comparison, compare_chains
 from core.ribbon import RibbonKind
 from core.structure import BackboneSegment, Structure
 
@@ -327,8 +327,9 @@ def compare_arguments(parser: argparse.ArgumentParser) -> None:
                         help="curve of the C^r fits: peptide-plane ribbon (default) or the curve through the Cα")
     parser.add_argument("--termini", choices=[t.value for t in Termini], default="atoms",
                         help="terminal ribbon points: N and C atoms when present (default) or Cα extrapolations")
-    parser.add_argument("--pairing", choices=("auto", "numbering", "alignment"), default="auto",
-                        help="pair residues by number or by sequence alignment (auto: by number when it agrees)")
+    parser.add_argument("--pairing", choices=PAIRINGS, default="auto",
+                        help="pair residues by number, by sequence alignment or by structural alignment "
+                             "(auto: by number when it agrees, else by structure)")
     parser.add_argument("--json", action="store_true", help="print a JSON object instead of the table")
 
 

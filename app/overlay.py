@@ -56,10 +56,10 @@ class ChainFit:
     Attributes
     ----------
     motion : moves the compared chain onto the edited one.
-    n_pairs : paired residues (by numbering or sequence alignment) with both Cα.
+    n_pairs : paired residues (by numbering or structural alignment) with both Cα.
     n_core : pairs the refined fit was computed on (closer than :data:`CORE_CUTOFF`).
     rms_core, rms_all : rms Cα distance (Å) over those and over all pairs after the fit.
-    pairing : 'numbering' or 'alignment'.
+    pairing : 'numbering' or 'structure' (see :func:`core.compare.pair_residues`).
     """
 
     motion: Superposition

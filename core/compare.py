@@ -1,9 +1,9 @@
 """Low-resolution comparison of two folds: Carson's factor D experiment (1996; math doc §12.1).
 
-Two protein chains are paired residue by residue (by numbering, or by a sequence
-alignment when the numbering differs) and superposed on their paired Cα. The **core
-set** is the reference on which every fit is judged: the pairs within a cutoff after an
-iterative fit, or a residue list given by the user. Then fits computed on less data are
+Two protein chains are paired residue by residue (by numbering, by sequence for the same
+protein numbered otherwise, or by a structural alignment) and superposed on their paired
+Cα. The **core set** is the reference on which every fit is judged: the pairs within a
+cutoff after an iterative fit, or a residue list given by the user. Then fits computed on less data are
 evaluated on the core set:
 
 * every m-th paired Cα (m = 2, 4, 8, 16), from every starting offset;
@@ -25,12 +25,16 @@ import numpy as np
 
 from .analysis import Termini
 from .deviation import level_residue_points
+from .fold_alignment import MIN_PAIRS, align_structures, tm_d0
 from .ribbon import RibbonKind, build_ribbon
 from .structure import BackboneSegment
 from .superpose import Superposition, align_sequences, superpose
 
-MIN_PAIRS = 3
-"""Fewest point pairs a superposition is computed from."""
+PAIRINGS = ("auto", "numbering", "alignment", "structure")
+"""How :func:`pair_residues` may pair residues."""
+SAME_PROTEIN = 0.9
+"""Sequence identity (of the shorter chain) from which two chains are the same protein,
+paired by sequence whatever their conformations."""
 
 
 @dataclass(frozen=True)
@@ -60,7 +64,7 @@ class Comparison:
 
     Attributes
     ----------
-    pairing : 'numbering' or 'alignment'.
+    pairing : 'numbering', 'alignment' or 'structure'.
     pairs_a, pairs_b : (n_pairs,) int64, paired residue indices in each chain.
     length_a, length_b : residues of each chain.
     rms_all : rms over all pairs of the fit on all paired Cα, Å.
@@ -99,16 +103,18 @@ def pair_residues(
     """Pair the residues of two chains (each a sequence of segments, in order).
 
     ``'numbering'`` pairs equal residue numbers and insertion codes; ``'alignment'`` aligns
-    the residue-name sequences (:func:`core.superpose.align_sequences`). ``'auto'`` uses the
-    numbering when the residues it pairs carry the same names and cover at least half of
-    the shorter chain, and the alignment otherwise.
+    the residue-name sequences (:func:`core.superpose.align_sequences`); ``'structure'``
+    refines that alignment by where the Cα lie (:func:`core.fold_alignment.align_structures`),
+    which homologues need. ``'auto'`` uses the numbering when the residues it pairs carry
+    the same names and cover at least half of the shorter chain, the sequence alignment when
+    it finds the same protein (:data:`SAME_PROTEIN`), and the structural alignment otherwise.
 
     Returns
     -------
     (indices into chain a, indices into chain b, the pairing used)
     """
-    if pairing not in ("auto", "numbering", "alignment"):
-        raise ValueError(f"pairing must be 'auto', 'numbering' or 'alignment'; got {pairing!r}")
+    if pairing not in PAIRINGS:
+        raise ValueError(f"pairing must be one of {', '.join(map(repr, PAIRINGS))}; got {pairing!r}")
     labels_a, labels_b = _labels(chain_a), _labels(chain_b)
     where_b = {label: k for k, label in enumerate(labels_b)}
     pairs_a = np.array([k for k, label in enumerate(labels_a) if label in where_b], dtype=np.int64)
@@ -118,7 +124,12 @@ def pair_residues(
     if pairing == "numbering" or (pairing == "auto" and agree and 2 * len(pairs_a) >= min(len(labels_a), len(labels_b))):
         return pairs_a, pairs_b, "numbering"
     pairs_a, pairs_b = align_sequences(names_a.tolist(), names_b.tolist())
-    return pairs_a, pairs_b, "alignment"
+    identity = np.count_nonzero(names_a[pairs_a] == names_b[pairs_b]) / min(len(names_a), len(names_b))
+    if pairing == "alignment" or (pairing == "auto" and identity >= SAME_PROTEIN) or len(pairs_a) < MIN_PAIRS:
+        return pairs_a, pairs_b, "alignment"
+    ca_a, ca_b = (np.concatenate([s.ca for s in chain]) for chain in (chain_a, chain_b))
+    pairs_a, pairs_b = align_structures(ca_a, ca_b, pairs_a, pairs_b)
+    return pairs_a, pairs_b, "structure"
 
 
 def tm_score(distances: np.ndarray, length: int) -> tuple[float, float]:
@@ -128,7 +139,7 @@ def tm_score(distances: np.ndarray, length: int) -> tuple[float, float]:
     """
     if length < 1:
         raise ValueError(f"length must be >= 1; got {length}")
-    d0 = max(1.24 * float(np.cbrt(length - 15)) - 1.8, 0.5)
+    d0 = tm_d0(length)
     return float(np.sum(1.0 / (1.0 + (np.asarray(distances) / d0) ** 2)) / length), d0
 
 

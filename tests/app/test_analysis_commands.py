@@ -138,6 +138,19 @@ def test_analyze_refuses_to_overwrite_results(tmp_path, capsys):
     assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary files left
 
 
+def test_compare_a_distant_homologue_by_structure_or_by_sequence(capsys):
+    common = ("compare", DATA / "3PTB.pdb.gz", DATA / "3SGB.pdb.gz", "--chains", "A:E", "--steps", "4", "--depths",
+              "2", "--core-cutoff", "3", "--json")
+    reports = {}
+    for pairing in ("auto", "alignment"):
+        status, out, _ = run(capsys, *common, "--pairing", pairing)
+        assert status == 0
+        reports[pairing] = json.loads(out)
+    assert reports["auto"]["pairing"] == "structure" and reports["alignment"]["pairing"] == "alignment"
+    assert reports["auto"]["tm_score"] > reports["alignment"]["tm_score"] + 0.1
+    assert reports["auto"]["n_core"] > 2 * reports["alignment"]["n_core"]
+
+
 @pytest.mark.parametrize(
     ("argv", "status", "message"),
     [

@@ -57,7 +57,7 @@ def test_proteases_are_superposed_on_the_edited_chain(window: MainWindow) -> Non
     for item in items:
         fixed, moving = list(trypsin.segments), [s for s in item.structure.segments if s.chain == item.chain]
         pairs_a, pairs_b, pairing = pair_residues(fixed, moving)
-        assert pairing == "alignment" and item.fit.n_pairs == len(pairs_a) > 200
+        assert pairing == "structure" and item.fit.n_pairs == len(pairs_a) > 200
         ca_a = np.concatenate([s.ca for s in fixed])[pairs_a]
         ca_b = np.concatenate([s.ca for s in moving])[pairs_b]
         distance = np.linalg.norm(ca_a - item.fit.motion.apply(ca_b), axis=1)
@@ -154,7 +154,7 @@ def test_new_structure_refits_and_bad_files_are_reported(window: MainWindow, tmp
     assert [i.fitted_to for i in window.comparison.items] == ["A", "A"]
     for item in window.comparison.items:
         assert window.comparison_view.actor_name(item) in window.plotter.actors
-        assert item.fit.rms_all > 5.0  # triosephosphate isomerase is not a serine protease
+        assert item.fit.n_pairs < 40  # triosephosphate isomerase is not a serine protease: few equivalent Cα
 
 
 def test_command_line_compare_screenshot(qtbot: QtBot, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
