@@ -33,7 +33,7 @@ from app.document import Document
 from core.compare import pair_residues
 from core.ribbon import Ribbon, segment_ribbon
 from core.structure import BackboneSegment, Structure, read_structure
-from core.superpose import Superposition, superpose
+from core.superpose import Superposition, fit_closest
 
 CORE_CUTOFF = 3.0
 """Å: the fit is refined on the paired Cα closer than this after fitting on themselves."""
@@ -105,14 +105,8 @@ def fit_chain(fixed_ca: np.ndarray, fixed: Sequence[BackboneSegment], moving: Se
     a, b = a[usable], b[usable]
     if len(a) < MIN_PAIRS:
         raise ValueError(f"only {len(a)} residue pair(s) with the edited chain; at least {MIN_PAIRS} are needed")
-    core = np.ones(len(a), dtype=bool)
-    for _ in range(20):
-        motion = superpose(a[core], b[core])
-        distance = np.linalg.norm(a - motion.apply(b), axis=1)
-        close = distance < CORE_CUTOFF
-        if close.sum() < MIN_PAIRS or np.array_equal(close, core):
-            break
-        core = close
+    motion, core = fit_closest(a, b, CORE_CUTOFF)
+    distance = np.linalg.norm(a - motion.apply(b), axis=1)
     return ChainFit(motion, len(a), int(core.sum()), _rms(distance[core]), _rms(distance), pairing)
 
 

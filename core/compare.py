@@ -3,8 +3,8 @@
 Two protein chains are paired residue by residue (by numbering, by sequence for the same
 protein numbered otherwise, or by a structural alignment) and superposed on their paired
 Cα. The **core set** is the reference on which every fit is judged: the pairs within a
-cutoff after an iterative fit, or a residue list given by the user. Then fits computed on less data are
-evaluated on the core set:
+cutoff after an iterative fit, or a residue list given by the user. Then fits computed on
+less data are evaluated on the core set:
 
 * every m-th paired Cα (m = 2, 4, 8, 16), from every starting offset;
 * the residue points ``C^r`` of both chains' ribbons at the integer level ``J − k``, on all
@@ -28,7 +28,7 @@ from .deviation import level_residue_points
 from .fold_alignment import MIN_PAIRS, align_structures, tm_d0
 from .ribbon import RibbonKind, build_ribbon
 from .structure import BackboneSegment
-from .superpose import Superposition, align_sequences, superpose
+from .superpose import Superposition, align_sequences, fit_closest, superpose
 
 PAIRINGS = ("auto", "numbering", "alignment", "structure")
 """How :func:`pair_residues` may pair residues."""
@@ -227,19 +227,13 @@ def compare_chains(
     )
 
 
-def _iterative_core(ca_a: np.ndarray, ca_b: np.ndarray, cutoff: float, max_rounds: int = 50) -> np.ndarray:
-    """Pairs within ``cutoff`` after fitting on themselves, iterated from all pairs."""
+def _iterative_core(ca_a: np.ndarray, ca_b: np.ndarray, cutoff: float) -> np.ndarray:
+    """Pairs within ``cutoff`` after fitting on themselves, iterated from all pairs (fewer
+    than 3 where the set collapses)."""
     if not (math.isfinite(cutoff) and cutoff > 0):
         raise ValueError(f"cutoff must be > 0 Å; got {cutoff:g}")
-    core = np.ones(len(ca_a), dtype=bool)
-    for _ in range(max_rounds):
-        if core.sum() < MIN_PAIRS:
-            break
-        close = _distances(ca_a, ca_b, superpose(ca_a[core], ca_b[core])) < cutoff
-        if np.array_equal(close, core):
-            break
-        core = close
-    return core
+    motion, _ = fit_closest(ca_a, ca_b, cutoff, rounds=50)
+    return _distances(ca_a, ca_b, motion) < cutoff
 
 
 def _curve_points(chain: Sequence[BackboneSegment], depth: int, kind: RibbonKind, termini: Termini) -> np.ndarray:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.distance import cdist
 
-from .superpose import Superposition, superpose
+from .superpose import Superposition, fit_closest
 
 GAP = 0.6
 """TM-score terms lost per residue left unpaired inside the alignment (TM-align's gap
@@ -71,21 +71,9 @@ def align_structures(
 
 def tm_fit(fixed: np.ndarray, moving: np.ndarray, d0: float) -> Superposition:
     """A superposition of paired points that favours the closest pairs (towards the
-    TM-score optimum): fit on all, then again on the pairs closer than 2 d0, then than d0,
-    each until the set settles (at most 5 times); a set of fewer than 3 pairs is not used."""
-    motion = superpose(fixed, moving)
-    for cutoff in (2.0 * d0, d0):
-        for _ in range(5):
-            close = np.linalg.norm(fixed - motion.apply(moving), axis=1) < cutoff
-            if close.sum() < MIN_PAIRS:
-                break
-            refit = superpose(fixed[close], moving[close])
-            settled = np.allclose(refit.rotation, motion.rotation) and np.allclose(refit.translation,
-                                                                                   motion.translation)
-            motion = refit
-            if settled:
-                break
-    return motion
+    TM-score optimum): refined on the pairs within 2 d0, then on those within d0."""
+    motion, _ = fit_closest(fixed, moving, 2.0 * d0)
+    return fit_closest(fixed, moving, d0, start=motion)[0]
 
 
 def monotone_pairs(score: np.ndarray, gap: float) -> tuple[np.ndarray, np.ndarray]:

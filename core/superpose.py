@@ -46,6 +46,26 @@ def superpose(fixed: np.ndarray, moving: np.ndarray) -> Superposition:
     return Superposition(rotation, translation, float(result.rmsd))
 
 
+def fit_closest(
+    fixed: np.ndarray, moving: np.ndarray, cutoff: float, start: Superposition | None = None, rounds: int = 20
+) -> tuple[Superposition, np.ndarray]:
+    """A superposition refined on the pairs it brings closer than ``cutoff`` (Å).
+
+    From ``start`` (default: the fit on all pairs), fit again on the pairs closer than
+    ``cutoff`` until that set settles (at most ``rounds`` times), stopping before a set of
+    fewer than 3 pairs. Returns the last fit and the (n,) bool set it was fitted on (all
+    pairs for the fit on all).
+    """
+    motion = superpose(fixed, moving) if start is None else start
+    used = np.ones(len(fixed), dtype=bool)
+    for _ in range(rounds):
+        close = np.linalg.norm(fixed - motion.apply(moving), axis=1) < cutoff
+        if close.sum() < 3 or np.array_equal(close, used):
+            break
+        motion, used = superpose(fixed[close], moving[close]), close
+    return motion, used
+
+
 def align_sequences(names_a: Sequence[str], names_b: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
     """Residues paired by a global alignment of two sequences of residue names.
 

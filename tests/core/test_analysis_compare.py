@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 from core.compare import compare_chains, pair_residues, tm_score
 from core.structure import read_structure
-from core.superpose import align_sequences, superpose
+from core.superpose import align_sequences, fit_closest, superpose
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 
@@ -50,6 +50,19 @@ def test_superpose_is_least_squares(tim):
         assert other > rms
     with pytest.raises(ValueError, match="n >= 3"):
         superpose(a[:2], b[:2])
+
+
+def test_a_refined_fit_ignores_the_pairs_that_moved(tim):
+    ca = tim.segments[0].ca
+    rotation = Rotation.from_euler("xyz", [30, -50, 10], degrees=True).as_matrix()
+    moved = ca @ rotation.T + [5.0, 0.0, -8.0]
+    loop = np.arange(60, 75)
+    moved[loop] += [9.0, 4.0, 0.0]  # a loop that differs: it pulls the fit on all pairs
+    assert superpose(ca, moved).rmsd > 1.0
+    motion, used = fit_closest(ca, moved, 1.0)
+    assert np.array_equal(np.flatnonzero(~used), loop)
+    np.testing.assert_allclose(motion.rotation, rotation.T, atol=1e-9)
+    np.testing.assert_allclose(np.delete(motion.apply(moved), loop, axis=0), np.delete(ca, loop, axis=0), atol=1e-6)
 
 
 def test_alignment_pairs_the_residues_left_after_deletions(tim):
