@@ -33,11 +33,10 @@ from app.document import Document
 from core.compare import pair_residues
 from core.ribbon import Ribbon, segment_ribbon
 from core.structure import BackboneSegment, Structure, read_structure
-from core.superpose import Superposition, fit_closest
+from core.superpose import MIN_PAIRS, Superposition, fit_closest
 
 CORE_CUTOFF = 3.0
 """Å: the fit is refined on the paired Cα closer than this after fitting on themselves."""
-MIN_PAIRS = 3
 PALETTE: tuple[tuple[int, int, int], ...] = (
     (31, 119, 180), (44, 160, 44), (148, 103, 189), (23, 190, 207), (140, 86, 75),
     (227, 119, 194), (255, 127, 14), (188, 189, 34), (90, 90, 90),

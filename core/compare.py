@@ -25,10 +25,10 @@ import numpy as np
 
 from .analysis import Termini
 from .deviation import level_residue_points
-from .fold_alignment import MIN_PAIRS, align_structures, tm_d0
+from .fold_alignment import align_structures, tm_d0
 from .ribbon import RibbonKind, build_ribbon
 from .structure import BackboneSegment
-from .superpose import Superposition, align_sequences, fit_closest, superpose
+from .superpose import MIN_PAIRS, Superposition, align_sequences, fit_closest, superpose
 
 PAIRINGS = ("auto", "numbering", "alignment", "structure")
 """How :func:`pair_residues` may pair residues."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.distance import cdist
 
-from .superpose import Superposition, fit_closest
+from .superpose import MIN_PAIRS, Superposition, fit_closest
 
 GAP = 0.6
 """TM-score terms lost per residue left unpaired inside the alignment (TM-align's gap
@@ -23,8 +23,6 @@ PAIR_CUTOFF = 5.0
 """Å: pairs farther apart after the final superposition are not kept."""
 ROUNDS = 10
 """Superposition and pairing rounds at most (they usually settle in 2–4)."""
-MIN_PAIRS = 3
-"""Fewest point pairs a superposition is computed from."""
 
 
 def tm_d0(length: int) -> float:
@@ -56,20 +54,21 @@ def align_structures(
     d0 = tm_d0(len(ca_a))
     best, best_score = pairs, -np.inf
     for _ in range(ROUNDS):
-        motion = tm_fit(ca_a[pairs[0]], ca_b[pairs[1]], d0)
+        motion = _tm_fit(ca_a[pairs[0]], ca_b[pairs[1]], d0)
         score = 1.0 / (1.0 + (cdist(ca_a, motion.apply(ca_b)) / d0) ** 2)
-        if score[pairs].sum() > best_score:  # the TM-score of these pairs, times len(ca_a)
-            best, best_score = pairs, score[pairs].sum()
+        pairs_score = score[pairs].sum()  # the TM-score of these pairs, times len(ca_a)
+        if pairs_score > best_score:
+            best, best_score = pairs, pairs_score
         found = monotone_pairs(score, GAP)
         if len(found[0]) < MIN_PAIRS or all(np.array_equal(p, q) for p, q in zip(found, pairs)):
             break
         pairs = found
-    motion = tm_fit(ca_a[best[0]], ca_b[best[1]], d0)
+    motion = _tm_fit(ca_a[best[0]], ca_b[best[1]], d0)
     close = np.linalg.norm(ca_a[best[0]] - motion.apply(ca_b[best[1]]), axis=1) < PAIR_CUTOFF
     return best[0][close], best[1][close]
 
 
-def tm_fit(fixed: np.ndarray, moving: np.ndarray, d0: float) -> Superposition:
+def _tm_fit(fixed: np.ndarray, moving: np.ndarray, d0: float) -> Superposition:
     """A superposition of paired points that favours the closest pairs (towards the
     TM-score optimum): refined on the pairs within 2 d0, then on those within d0."""
     motion, _ = fit_closest(fixed, moving, 2.0 * d0)

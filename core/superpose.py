@@ -15,6 +15,9 @@ import numpy as np
 
 from . import _validate
 
+MIN_PAIRS = 3
+"""Fewest point pairs a superposition is computed from."""
+
 
 @dataclass(frozen=True)
 class Superposition:
@@ -38,8 +41,8 @@ def superpose(fixed: np.ndarray, moving: np.ndarray) -> Superposition:
     """
     fixed = _validate.finite_array("fixed", fixed, ndim=(2,))
     moving = _validate.finite_array("moving", moving, ndim=(2,))
-    if fixed.shape != moving.shape or fixed.shape[1:] != (3,) or len(fixed) < 3:
-        raise ValueError(f"fixed and moving must have one shape (n >= 3, 3); got {fixed.shape} and {moving.shape}")
+    if fixed.shape != moving.shape or fixed.shape[1:] != (3,) or len(fixed) < MIN_PAIRS:
+        raise ValueError(f"fixed and moving must have one shape (n >= {MIN_PAIRS}, 3); got {fixed.shape} and {moving.shape}")
     result = gemmi.superpose_positions(_positions(fixed), _positions(moving))
     rotation = np.array(result.transform.mat.tolist())
     translation = np.array(result.transform.vec.tolist())
@@ -60,7 +63,7 @@ def fit_closest(
     used = np.ones(len(fixed), dtype=bool)
     for _ in range(rounds):
         close = np.linalg.norm(fixed - motion.apply(moving), axis=1) < cutoff
-        if close.sum() < 3 or np.array_equal(close, used):
+        if close.sum() < MIN_PAIRS or np.array_equal(close, used):
             break
         motion, used = superpose(fixed[close], moving[close]), close
     return motion, used
