@@ -23,10 +23,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from core.analysis import AnalysisOptions, analyse_structure
-from core.structure import read_structure
+from core.analysis.database import AnalysisOptions, analyse_structure
+from core.protein.reading import read_structure
 
-COMMAND = [sys.executable, "-c", "import sys; from app.cli import main; sys.exit(main())"]
+COMMAND = [sys.executable, "-c", "import sys; from app.main import main; sys.exit(main())"]
 # Math doc §12.2: (mode, depth) -> rms all, helix, sheet, other (peptide ribbon), all (Cα ribbon).
 REFERENCE = {
     ("integer", "0"): (1.22, 1.39, 0.93, 1.18, 0.00),
@@ -52,7 +52,7 @@ def analyze(paths: list[Path], out: Path, jobs: int, *options: str) -> float:
 
 def one_process(folder: Path) -> tuple[int, int, float, float]:
     """Files, residues, seconds reading and seconds analysing every file in this process."""
-    from app.analysis_commands import structure_paths
+    from app.cli.analysis import structure_paths
 
     structures, reading = [], time.perf_counter()
     for path in structure_paths([folder]):

@@ -8,12 +8,11 @@ any level to the finest in under 1 ms for 2,000 residues (2**11 segments).
 from __future__ import annotations
 
 import numpy as np
-
 from timing import best_ms
 
-from core.editing import move_control_point, tug_curve
-from core.filters import level_filters, refinement_matrix, wavelet_matrix
-from core.wavelets import decompose, reconstruct
+from core.curves.editing import move_control_point, tug_curve
+from core.curves.filters import level_filters, refinement_matrix, wavelet_matrix
+from core.curves.wavelets import decompose, reconstruct
 
 DENSE_UP_TO = 12  # dense analysis matrices beyond 2**12 + 3 rows take minutes and gigabytes
 

@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 from PySide6.QtWidgets import QApplication
 
-from app.document import Document
-from app.main_window import MainWindow
-from app.scene import Layer
+from app.editor.document import Document
+from app.editor.main_window import MainWindow
+from app.editor.scene.scene import Layer
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
 STRUCTURES = (("1UBQ.pdb.gz", "ubiquitin, 76 residues"), ("1AYE.pdb.gz", "procarboxypeptidase, 401 residues"),

@@ -19,7 +19,7 @@ import numpy as np
 from bench_editor import MOVES, STRUCTURES, Clock, display, open_window
 from PySide6.QtWidgets import QApplication
 
-from app.main_window import MainWindow
+from app.editor.main_window import MainWindow
 
 
 def drag(window: MainWindow, level: float, *, while_dragging: bool) -> tuple[Clock, list[float], float]:

@@ -21,13 +21,13 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from timing import best_ms
 
-from core.model import EditableModel
-from core.regularize import regularized
-from core.structure import read_structure
-from core.validation import topology, validate
+from core.geometry.regularize import regularized
+from core.geometry.topology import topology
+from core.geometry.validation import validate
+from core.protein.model import EditableModel
+from core.protein.reading import read_structure
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
 TARGETS = (20, 200)

@@ -12,14 +12,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
 from timing import best_ms
 
-from core.editing import move_control_point
-from core.frames import remap_atoms, residue_frames
-from core.model import EditableModel
-from core.ribbon import build_ribbon
-from core.structure import read_structure
+from core.curves.editing import move_control_point
+from core.protein.frames import remap_atoms, residue_frames
+from core.protein.model import EditableModel
+from core.protein.reading import read_structure
+from core.protein.ribbon import build_ribbon
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
 

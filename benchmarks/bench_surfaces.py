@@ -12,12 +12,12 @@ from pathlib import Path
 
 from timing import best_ms
 
-from core.dna import ideal_bdna
-from core.globe import cylinder, globe
-from core.molsurface import molecular_surface
-from core.remesh import remesh
-from core.structure import read_atoms
-from core.volume import model_density
+from core.protein.reading import read_atoms
+from core.surfaces.dna import ideal_bdna
+from core.surfaces.globe import cylinder, globe
+from core.surfaces.molecular import molecular_surface
+from core.surfaces.remesh import remesh
+from core.surfaces.volume import model_density
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
 ENTRIES = ("1UBQ.pdb.gz", "1TIM.pdb.gz", "4YVS.cif.gz")

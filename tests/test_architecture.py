@@ -1,9 +1,12 @@
-"""The dependency direction app -> core: core imports no GUI, rendering or plotting package."""
+"""The architecture holds: the import-linter contracts of pyproject.toml (core in layers, no GUI in
+core, the command line and the editor apart), and the headless commands load no GUI package."""
 
 import json
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 GUI_PACKAGES = ("PySide6", "vtk", "vtkmodules", "pyvista", "pyvistaqt", "qtpy", "matplotlib")
@@ -31,3 +34,28 @@ print(json.dumps(sorted(loaded & set({GUI_PACKAGES!r}))))
     )
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout) == []
+
+
+@pytest.mark.parametrize("command", [
+    ["info", "resources/examples/1UBQ.pdb"],
+    ["curve", "resources/examples/1UBQ.pdb", "--level", "3", "--csv"],
+    ["edit", "resources/examples/1UBQ.pdb", "--chain", "A", "--level", "3", "--point", "5", "--move", "4,0,0",
+     "--regularize", "-o", "{out}"],
+    ["validate", "resources/examples/1UBQ.pdb", "--json"],
+])
+def test_headless_commands_load_no_gui_package(command: list[str], tmp_path: Path) -> None:
+    """``ribbonwave info``, ``curve``, ``edit`` and ``validate`` run without Qt, VTK or matplotlib."""
+    argv = [arg.replace("{out}", str(tmp_path / "bent.pdb")) for arg in command]
+    script = f"""
+import contextlib, io, json, sys
+from app.main import main
+with contextlib.redirect_stdout(io.StringIO()):
+    status = main({argv!r})
+loaded = {{name.partition(".")[0] for name in sys.modules}}
+print(json.dumps([status, sorted(loaded & set({GUI_PACKAGES!r}))]))
+"""
+    result = subprocess.run(
+        [sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, check=False
+    )
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout) == [0, []]

@@ -6,7 +6,7 @@ import pytest
 from PySide6.QtCore import QSettings
 from PySide6.QtWidgets import QApplication, QMessageBox
 
-from app.document import Document
+from app.editor.document import Document
 
 DATA = Path(__file__).resolve().parent.parent / "data"
 

@@ -1,0 +1,494 @@
+"""Headless database commands: ``analyze`` (Carson's Fig. 7 over many files) and ``compare``
+(two chains superposed, fits on less data judged on a core set). Core does the science;
+this module reads arguments, runs files in parallel, writes CSV/JSON/PNG and prints.
+
+Output formats are a contract for other programs: the columns of ``summary.csv``,
+``residues.csv`` and ``skipped.csv``, and the field names of ``compare --json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import csv
+import functools
+import io
+import json
+import multiprocessing
+import os
+import re
+import sys
+from collections.abc import Iterator
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from app.cli.structure import load
+from app.errors import InputError
+from core.analysis.compare import PAIRINGS, Comparison, compare_chains
+from core.analysis.database import (
+    CLASSES,
+    MODES,
+    RIBBONS,
+    AnalysisOptions,
+    ChainSelection,
+    FileAnalysis,
+    Gaps,
+    PooledStatistics,
+    SkippedFile,
+    SSPolicy,
+    SummaryRow,
+    Termini,
+    analyse_path,
+    rms_crossing,
+)
+from core.protein.ribbon import RibbonKind
+from core.protein.structure import BackboneSegment, Structure
+
+SUMMARY_COLUMNS = ("ribbon", "mode", "depth", "class", "n_residues", "rms", "sd")
+RESIDUE_COLUMNS = ("file", "entry", "chain", "curve", "resseq", "icode", "resname", "ss", "class")
+OUTPUTS = ("residues.csv", "summary.csv", "skipped.csv", "fig7.png")
+STRUCTURE_SUFFIXES = (".pdb", ".ent", ".cif", ".mmcif")
+CA_CA = 3.8
+"""Ideal Cα–Cα distance (Å): the rms a coarse curve should stay below (Carson 1996)."""
+PAPER = {2: 2.1, 3: 3.3}
+"""Carson's pooled rms (Å) of the peptide-plane ribbon at integer depths 2 and 3."""
+CLASS_COLOURS = {"all": "black", "helix": "tab:red", "sheet": "tab:blue", "other": "tab:gray"}
+RIBBON_TITLES = {"peptide": "peptide-plane ribbon", "calpha": "Cα ribbon"}
+Outcome = tuple[FileAnalysis | SkippedFile, str]
+"""A file's analysis (or why it was skipped) and its ``residues.csv`` rows."""
+
+
+# --------------------------------------------------------------------------- analyze
+
+
+def analyze_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("paths", nargs="+", type=Path, metavar="PATH",
+                        help="structure files or folders (searched recursively for .pdb/.ent/.cif/.mmcif, optionally .gz)")
+    parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUTDIR",
+                        help="folder for residues.csv, summary.csv, skipped.csv and fig7.png (created if needed)")
+    parser.add_argument("--overwrite", action="store_true", help="replace those files if OUTDIR already has them")
+    parser.add_argument("--jobs", type=_positive_int, default=len(os.sched_getaffinity(0)), metavar="N",
+                        help="worker processes (default: all cores)")
+    parser.add_argument("--scheduler", nargs="?", const="local", metavar="ADDRESS",
+                        help="run on a Dask cluster (e.g. tcp://host:8786); without ADDRESS, a local cluster "
+                        "of --jobs workers (needs the 'cluster' extra: dask[distributed])")
+    parser.add_argument("--chains", choices=[c.value for c in ChainSelection], default="all",
+                        help="every protein chain (default) or only the longest chain of each file")
+    parser.add_argument("--gaps", choices=[g.value for g in Gaps], default="split",
+                        help="a chain broken at a Cα–Cα gap gives one curve per piece (split, default) or one curve (join)")
+    parser.add_argument("--termini", choices=[t.value for t in Termini], default="atoms",
+                        help="terminal ribbon points: the N and C atoms when present (atoms, default) "
+                        "or half-bond extrapolations of the Cα (calpha)")
+    parser.add_argument("--ss", choices=[s.value for s in SSPolicy], default="auto",
+                        help="helix/sheet/other from the file's HELIX/SHEET records, else computed by DSSP (auto, "
+                        "default); records: files without records count only in class 'all'")
+    parser.add_argument("--max-depth", type=float, default=AnalysisOptions.max_depth, metavar="D",
+                        help="deepest decomposition step (default %(default)g)")
+    parser.add_argument("--fraction-step", type=float, default=AnalysisOptions.fraction_step, metavar="S",
+                        help="spacing of the fractional depths (default %(default)g)")
+
+
+def run_analyze(args: argparse.Namespace) -> int:
+    try:
+        options = AnalysisOptions(args.chains, args.gaps, args.termini, args.ss, args.max_depth, args.fraction_step)
+    except ValueError as error:
+        raise InputError(str(error)) from None
+    paths = structure_paths(args.paths)
+    _prepare_output(args.output, args.overwrite)
+    pooled, skipped = PooledStatistics(options), []
+    waiting: dict[int, Outcome] = {}  # finished out of order
+    with (_atomic_path(args.output / "residues.csv") as table_path, table_path.open("w", encoding="utf-8") as table,
+          tqdm(total=len(paths), unit="file", desc="analysing", file=sys.stderr, mininterval=0.5) as progress):
+        table.write(",".join(RESIDUE_COLUMNS + tuple(c.name for c in options.columns)) + "\n")
+        for index, (result, lines) in _run(paths, options, args.jobs, args.scheduler):
+            progress.update()
+            if isinstance(result, SkippedFile):
+                progress.write(f"skipped {result.path}: {result.reason}", file=sys.stderr)
+            waiting[index] = result, lines
+            while (pooled.n_files + len(skipped)) in waiting:  # keep the files in input order
+                ready, lines = waiting.pop(pooled.n_files + len(skipped))
+                if isinstance(ready, SkippedFile):
+                    skipped.append(ready)
+                else:
+                    pooled.add(ready)
+                    table.write(lines)
+    rows = pooled.rows()
+    _atomic_text(args.output / "summary.csv", summary_csv(rows))
+    _atomic_text(args.output / "skipped.csv", _csv_text([("file", "reason")] + [(str(s.path), s.reason) for s in skipped]))
+    with _atomic_path(args.output / "fig7.png") as png:
+        plot_fig7(rows, png)
+    print(summary_text(pooled, skipped, args.output))
+    return 0
+
+
+def structure_paths(paths: list[Path]) -> list[Path]:
+    """The files named, and the structure files inside the folders named (sorted, recursive)."""
+    found: list[Path] = []
+    for path in paths:
+        if path.is_dir():
+            found += sorted(
+                p for p in path.rglob("*")
+                if p.is_file() and not p.name.startswith(".")
+                and p.name.lower().removesuffix(".gz").endswith(STRUCTURE_SUFFIXES)
+            )
+        else:
+            found.append(path)  # a file that cannot be read is reported and skipped later
+    if not found:
+        raise InputError(f"no structure files (.pdb, .ent, .cif, .mmcif, optionally .gz) in {', '.join(map(str, paths))}")
+    return found
+
+
+def _run(paths: list[Path], options: AnalysisOptions, jobs: int, scheduler: str | None
+         ) -> Iterator[tuple[int, Outcome]]:
+    """(index, result) of every path, in order of completion."""
+    if scheduler is not None:
+        yield from _run_dask(paths, options, jobs, scheduler)
+    elif jobs == 1 or len(paths) == 1:
+        for index, path in enumerate(paths):
+            yield index, analyse_file(path, options)
+    else:
+        context = multiprocessing.get_context("forkserver")  # no fork of a threaded parent
+        context.set_forkserver_preload(["app.cli.analysis"])
+        with ProcessPoolExecutor(min(jobs, len(paths)), mp_context=context) as pool:
+            futures = {pool.submit(analyse_file, path, options): index for index, path in enumerate(paths)}
+            try:
+                for future in as_completed(futures):
+                    index = futures.pop(future)  # hold no finished result longer than needed
+                    yield index, _outcome(future, paths[index])
+            except BaseException:  # Ctrl+C or an error: drop the files not started yet
+                pool.shutdown(cancel_futures=True)
+                raise
+
+
+def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: str
+              ) -> Iterator[tuple[int, Outcome]]:
+    try:
+        from dask.distributed import Client, LocalCluster, as_completed as dask_completed
+    except ImportError:
+        raise InputError("--scheduler needs Dask: pip install 'dask[distributed]' (the 'cluster' extra)") from None
+    with contextlib.ExitStack() as stack:
+        try:
+            scheduler = address
+            if address == "local":
+                scheduler = stack.enter_context(LocalCluster(n_workers=jobs, threads_per_worker=1, dashboard_address=None))
+            client = stack.enter_context(Client(scheduler, timeout=10))
+        except (OSError, ValueError) as error:
+            raise InputError(f"cannot reach the Dask scheduler {address}: {error}") from None
+        futures = client.map(analyse_file, paths, options=options, pure=False)
+        index = {future.key: k for k, future in enumerate(futures)}
+        completed = dask_completed(futures)
+        del futures  # a result is released on the cluster once it has been handled
+        for future in completed:
+            k = index.pop(future.key)
+            yield k, _outcome(future, paths[k])
+
+
+def analyse_file(path: Path, options: AnalysisOptions) -> Outcome:
+    """The task run by a worker: the rows are formatted there too, in parallel."""
+    result = analyse_path(path, options)
+    return result, residue_lines(result) if isinstance(result, FileAnalysis) else ""
+
+
+def _outcome(future, path: Path) -> Outcome:
+    """A finished task's outcome; a worker that died gives a skipped file, not a failed run."""
+    try:
+        return future.result()
+    except Exception as error:  # noqa: BLE001 - e.g. a worker killed while reading this file
+        return SkippedFile(path, f"worker failed ({type(error).__name__}: {error})"), ""
+
+
+def _prepare_output(folder: Path, overwrite: bool) -> None:
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{folder}: exists and is not a folder")
+    existing = [name for name in OUTPUTS if (folder / name).exists()]
+    if existing and not overwrite:
+        raise InputError(f"{folder}: already has {', '.join(existing)}; use --overwrite to replace them")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise InputError(f"{folder}: cannot create the folder ({error.strerror})") from None
+
+
+def residue_lines(analysis: FileAnalysis) -> str:
+    """The ``residues.csv`` rows of one file: the residue, its class and ``|Cα − C^r|`` (Å, 3
+    decimals, empty beyond a curve's lowest level) in every depth column."""
+    head = f"{_field(str(analysis.path))},{_field(analysis.entry)}"
+    number = ",".join(["%.3f"] * analysis.deviations.shape[1])
+    return "".join(
+        f"{head},{_field(chain)},{curve},{resseq},{_field(icode)},{_field(resname)},{ss},{ss_class},"
+        + (number % tuple(values)).replace("nan", "") + "\n"
+        for values, chain, curve, resseq, icode, resname, ss, ss_class in zip(
+            analysis.deviations.tolist(), analysis.chain.tolist(), analysis.curve.tolist(), analysis.resseq.tolist(),
+            analysis.icode.tolist(), analysis.resname.tolist(), analysis.ss.tolist(), analysis.ss_class.tolist(),
+        )
+    )
+
+
+def summary_csv(rows: list[SummaryRow]) -> str:
+    """``ribbon,mode,depth,class,n_residues,rms,sd`` with rms and SD in Å."""
+    return _csv_text([SUMMARY_COLUMNS] + [
+        (r.ribbon, r.mode, f"{r.depth:g}", r.ss_class, r.n_residues, f"{r.rms:.4f}", f"{r.sd:.4f}") for r in rows
+    ])
+
+
+def summary_text(pooled: PooledStatistics, skipped: list[SkippedFile], folder: Path) -> str:
+    """The report printed at the end of ``analyze``."""
+    rows = pooled.rows()
+    lines = [
+        f"analysed {pooled.n_files} file(s), {pooled.n_curves} curves, {pooled.n_residues} residues"
+        + (f"; skipped {len(skipped)} (listed in {folder / 'skipped.csv'})" if skipped else ""),
+        f"wrote {', '.join(str(folder / name) for name in OUTPUTS)}",
+        f"{pooled.n_residues_without_records} residues in {pooled.n_files_without_records} file(s) without "
+        "HELIX/SHEET records: " + ("counted only in class 'all'" if pooled.options.ss is SSPolicy.RECORDS
+                                   else "helix/sheet/other computed by DSSP"),
+    ]
+    if not rows:
+        return "\n".join(lines)
+    stat = {(r.ribbon, r.mode, r.depth, r.ss_class): r for r in rows}
+
+    def rms(ribbon: str, mode: str, depth: float, name: str = "all", width: int = 8) -> str:
+        row = stat.get((ribbon, mode, float(depth), name))
+        return f"{row.rms:{width}.2f}" if row else f"{'–':>{width}}"
+
+    lines += ["", "pooled rms |Cα − C^r| in Å (SD of the distances) by decomposition step (depth)",
+              f"{'':<17}{'peptide-plane ribbon':^45}{'Cα ribbon':>11}",
+              f"{'mode':<11}{'depth':>6}{'all (SD)':>14}{'helix':>8}{'sheet':>8}{'other':>8}{'residues':>10}{'all':>8}"]
+    for mode in MODES:
+        for depth in sorted({r.depth for r in rows if r.mode == mode}):
+            every = stat.get(("peptide", mode, depth, "all"))
+            first = f"{every.rms:.2f} ({every.sd:.2f})" if every else "–"
+            lines.append(f"{mode:<11}{depth:>6g}{first:>14}" + "".join(rms("peptide", mode, depth, c) for c in CLASSES[1:])
+                         + f"{every.n_residues if every else 0:>10}" + rms("calpha", mode, depth))
+    lines += ["", f"{'':<42}{'peptide':>8}{'Cα':>8}   Carson 1996 (230 proteins)"]
+    for depth, paper in PAPER.items():
+        lines.append(f"{f'rms at 1/{2**depth} of the segments (depth {depth}), Å':<42}"
+                     f"{rms('peptide', 'integer', depth)}{rms('calpha', 'integer', depth)}   {paper}")
+    crossings = "".join(f"{c:8.2f}" if c is not None else f"{'never':>8}"
+                        for c in (rms_crossing(rows, CA_CA, ribbon) for ribbon in ("peptide", "calpha")))
+    lines.append(f"{f'fractional depth where the rms passes {CA_CA} Å':<42}{crossings}   between 2.0 and 3.0")
+    lines.append("(the crossing is interpolated linearly between the fractional depths computed)")
+    return "\n".join(lines)
+
+
+def plot_fig7(rows: list[SummaryRow], path: Path) -> None:
+    """Carson's Fig. 7: rms ± 1 SD of ``|Cα − C^r|`` against decomposition step, one series
+    per class; integer and fractional modes side by side, one row per ribbon."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(11, 8), layout="constrained")
+    FigureCanvasAgg(figure)
+    axes = figure.subplots(len(RIBBONS), len(MODES), sharey=True, squeeze=False)
+    for i, ribbon in enumerate(r.value for r in RIBBONS):
+        for k, mode in enumerate(MODES):
+            ax = axes[i][k]
+            step = min(np.diff(sorted({r.depth for r in rows if r.mode == mode})), default=1.0)
+            for c, name in enumerate(CLASSES):
+                series = sorted((r.depth, r.rms, r.sd) for r in rows if (r.ribbon, r.mode, r.ss_class) == (ribbon, mode, name))
+                if series:
+                    x, y, sd = np.array(series).T
+                    ax.errorbar(x + (c - 1.5) * 0.1 * step, y, yerr=sd, fmt="_", markersize=10, capsize=2,
+                                elinewidth=1, color=CLASS_COLOURS[name], label=name)
+            ax.axhline(CA_CA, color="0.6", linestyle="--", linewidth=0.8)
+            ax.text(0.01, CA_CA, f" Cα–Cα {CA_CA} Å", va="bottom", color="0.4", fontsize=8,
+                    transform=ax.get_yaxis_transform())
+            ax.set_title(f"{RIBBON_TITLES[ribbon]}, {mode} levels "
+                         + ("(level J − step: 1/2, 1/4, … of the segments)" if mode == "integer" else "(level log2 N − step)"),
+                         fontsize=10)
+            ax.set_xlabel("decomposition step")
+            ax.grid(alpha=0.3)
+        axes[i][0].set_ylabel("|Cα − $C^r$| (Å): rms ± 1 SD")
+    axes[0][0].legend(title="residues", fontsize=8)
+    figure.suptitle("Distance of the Cα to the low-resolution curve (after Carson 1996, Fig. 7)")
+    figure.savefig(path, dpi=110, format="png")
+
+
+# --------------------------------------------------------------------------- compare
+
+
+def compare_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file_a", type=Path, metavar="A", help="structure file (PDB or mmCIF, optionally gzipped)")
+    parser.add_argument("file_b", type=Path, nargs="?", metavar="B", help="second structure file (default: A)")
+    parser.add_argument("--chains", type=_chain_pair, metavar="X:Y",
+                        help="chain X of A and chain Y of B (default: the first two chains of A when B is not "
+                        "given, else the first chain of each)")
+    parser.add_argument("--core", metavar="RESIDUES",
+                        help="core set as residue numbers of chain X, e.g. 5-20,31,40A (default: the pairs within "
+                        "--core-cutoff after an iterative fit)")
+    parser.add_argument("--core-cutoff", type=float, default=1.0, metavar="Å",
+                        help="distance cutoff of the iterative core set (default %(default)g Å)")
+    parser.add_argument("--steps", type=_int_list, default=(2, 4, 8, 16), metavar="M,...",
+                        help="fit on every M-th paired Cα from every offset (default 2,4,8,16)")
+    parser.add_argument("--depths", type=_int_list, default=(1, 2, 3, 4), metavar="K,...",
+                        help="fit on the residue points C^r of the curves at level J − K (default 1,2,3,4)")
+    parser.add_argument("--ribbon", choices=[k.value for k in RibbonKind], default=RibbonKind.PEPTIDE.value,
+                        help="curve of the C^r fits: peptide-plane ribbon (default) or the curve through the Cα")
+    parser.add_argument("--termini", choices=[t.value for t in Termini], default="atoms",
+                        help="terminal ribbon points: N and C atoms when present (default) or Cα extrapolations")
+    parser.add_argument("--pairing", choices=PAIRINGS, default="auto",
+                        help="pair residues by number, by sequence alignment or by structural alignment "
+                             "(auto: by number when it agrees, else by structure)")
+    parser.add_argument("--json", action="store_true", help="print a JSON object instead of the table")
+
+
+def run_compare(args: argparse.Namespace) -> int:
+    structure_a = load(args.file_a)
+    structure_b = load(args.file_b) if args.file_b is not None else structure_a
+    name_a, name_b = args.chains or _default_chains(structure_a, structure_b, args.file_b is None)
+    chain_a, chain_b = _chain(structure_a, name_a), _chain(structure_b, name_b)
+    core = None if args.core is None else _core_mask(chain_a, args.core)
+    try:
+        result = compare_chains(chain_a, chain_b, core_residues=core, cutoff=args.core_cutoff, steps=args.steps,
+                                depths=args.depths, ribbon=args.ribbon, termini=args.termini, pairing=args.pairing)
+    except ValueError as error:
+        raise InputError(str(error)) from None
+    report = comparison_report(result, f"{args.file_a} chain {name_a}",
+                               f"{args.file_b or args.file_a} chain {name_b}")
+    print(json.dumps(report, indent=2) if args.json else comparison_text(report))
+    return 0
+
+
+def comparison_report(result: Comparison, label_a: str, label_b: str) -> dict:
+    """The ``compare --json`` object (lengths in Å)."""
+    return {
+        "chain_a": label_a,
+        "chain_b": label_b,
+        "length_a": result.length_a,
+        "length_b": result.length_b,
+        "pairing": result.pairing,
+        "n_pairs": result.n_pairs,
+        "rms_all": round(result.rms_all, 4),
+        "tm_score": round(result.tm_score, 4),
+        "tm_score_length": result.length_a,
+        "tm_score_d0": round(result.d0, 4),
+        "tm_score_note": "superposition on all paired Cα; normalised by the length of the first chain",
+        "core_rule": result.core_rule,
+        "n_core": result.n_core,
+        "rms_core": round(result.rms_core, 4),
+        "fits": [
+            {"points": f.points, "depth": f.depth, "every": f.every, "start": f.start, "n_fit": f.n_fit,
+             "rms_core": round(f.rms_core, 4)}
+            for f in result.fits
+        ],
+    }
+
+
+def comparison_text(report: dict) -> str:
+    """The ``compare`` table."""
+    lines = [
+        f"{report['chain_a']} ({report['length_a']} residues) vs {report['chain_b']} ({report['length_b']} residues)",
+        f"{report['n_pairs']} residue pairs by {report['pairing']}",
+        f"fit on all paired Cα: rms {report['rms_all']:.3f} Å; TM-score {report['tm_score']:.4f} (of this "
+        f"superposition, normalised by the length of the first chain, {report['tm_score_length']} residues; "
+        f"d0 = {report['tm_score_d0']:.2f} Å)",
+        f"core set: {report['n_core']} pairs ({report['core_rule']}); best fit on the core: rms {report['rms_core']:.3f} Å",
+        "",
+        "fits on fewer data, each judged by the rms over the core set (Å):",
+        f"{'fitted on':<20}{'every':>6}{'n fit':>7}{'min':>8}{'mean':>8}{'max':>8}   by start 1, 2, ...",
+    ]
+    groups: dict[tuple[str, int, int], list[dict]] = {}
+    for fit in report["fits"]:
+        groups.setdefault((fit["points"], fit["depth"], fit["every"]), []).append(fit)
+    for (points, depth, every), fits in groups.items():
+        rms = [f["rms_core"] for f in fits]
+        name = "Cα" if points == "CA" else f"C^r at level J − {depth}"
+        lines.append(f"{name:<20}{every:>6}{fits[0]['n_fit']:>7}{min(rms):8.3f}{np.mean(rms):8.3f}{max(rms):8.3f}   "
+                     + " ".join(f"{r:.3f}" for r in rms))
+    return "\n".join(lines)
+
+
+def _default_chains(a: Structure, b: Structure, same_file: bool) -> tuple[str, str]:
+    names_a = list(dict.fromkeys(s.chain for s in a.segments))
+    if not same_file:
+        return names_a[0], next(s.chain for s in b.segments)
+    if len(names_a) < 2:
+        raise InputError(f"{a.path}: has one protein chain ({names_a[0]}); give a second file or --chains X:Y")
+    return names_a[0], names_a[1]
+
+
+def _chain(structure: Structure, name: str) -> list[BackboneSegment]:
+    segments = [s for s in structure.segments if s.chain == name]
+    if not segments:
+        chains = ", ".join(dict.fromkeys(s.chain for s in structure.segments))
+        raise InputError(f"{structure.path}: no protein chain {name!r} (chains: {chains})")
+    return segments
+
+
+def _core_mask(chain: list[BackboneSegment], text: str) -> np.ndarray:
+    """Chain residues named by a list such as ``5-20,31,40A`` (ranges by residue number)."""
+    resseq = np.concatenate([s.resseq for s in chain])
+    labels = [f"{n}{i}" for s in chain for n, i in zip(s.resseq.tolist(), s.icode.tolist())]
+    mask = np.zeros(len(resseq), dtype=bool)
+    for item in text.split(","):
+        item = item.strip()
+        if match := re.fullmatch(r"(-?\d+)-(-?\d+)", item):
+            picked = (resseq >= int(match[1])) & (resseq <= int(match[2]))
+        else:
+            picked = np.array([label == item for label in labels], dtype=bool)
+        if not picked.any():
+            raise InputError(f"--core: no residue {item!r} in chain {chain[0].chain}")
+        mask |= picked
+    return mask
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number; got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1; got {value}")
+    return value
+
+
+def _int_list(text: str) -> tuple[int, ...]:
+    try:
+        values = tuple(int(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected whole numbers separated by commas; got {text!r}") from None
+    if any(v < 1 for v in values):
+        raise argparse.ArgumentTypeError(f"numbers must be >= 1; got {text!r}")
+    return values
+
+
+def _chain_pair(text: str) -> tuple[str, str]:
+    parts = text.split(":")
+    if len(parts) != 2 or not all(parts):
+        raise argparse.ArgumentTypeError(f"expected two chain ids X:Y; got {text!r}")
+    return parts[0], parts[1]
+
+
+@functools.lru_cache(maxsize=None)
+def _field(text: str) -> str:
+    """``text`` as one CSV field (quoted only when it needs to be)."""
+    if any(c in text for c in ',"\r\n'):
+        return '"' + text.replace('"', '""') + '"'
+    return text
+
+
+def _csv_text(rows: list[tuple]) -> str:
+    out = io.StringIO()
+    csv.writer(out, lineterminator="\n").writerows(rows)
+    return out.getvalue()
+
+
+def _atomic_text(path: Path, text: str) -> None:
+    with _atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+
+
+@contextlib.contextmanager
+def _atomic_path(path: Path) -> Iterator[Path]:
+    """A temporary path next to ``path`` that replaces ``path`` when the block succeeds."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)

@@ -1,0 +1,113 @@
+"""The headless ``info`` command, and reading a structure for any command (core only, no Qt).
+
+``info --json`` is a contract for other programs: it keeps its field names.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from app.errors import InputError
+from core.protein.reading import read_structure
+from core.protein.structure import Structure, StructureError
+
+
+def load(path: Path) -> Structure:
+    """Read a structure, turning reader errors into :class:`InputError`; print its warnings."""
+    try:
+        structure = read_structure(path)
+    except StructureError as error:
+        raise InputError(str(error)) from None
+    for warning in structure.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
+    return structure
+
+
+# ------------------------------------------------------------------------------ info
+
+
+def info_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("file", type=Path, metavar="FILE", help="structure file (PDB or mmCIF, optionally gzipped)")
+    parser.add_argument("--json", action="store_true", help="print a JSON object instead of text")
+
+
+def summary(structure: Structure) -> dict:
+    """Chains, segments, residues, secondary structure and maximum levels of a structure."""
+    segments = []
+    for number, segment in enumerate(structure.segments):
+        segments.append({
+            "chain": segment.chain,
+            "segment": segment_number(structure, number),
+            "first": segment.labels[0],
+            "last": segment.labels[-1],
+            "residues": len(segment),
+            "max_level_peptide": round(float(np.log2(len(segment))), 4),
+            "max_level_calpha": round(float(np.log2(len(segment) + 1)), 4),
+        })
+    ss = Counter(np.concatenate([s.ss for s in structure.segments]).tolist())
+    return {
+        "file": str(structure.path),
+        "format": structure.source_format,
+        "entry": structure.entry_id,
+        "title": structure.title,
+        "models": structure.n_models,
+        "atoms": structure.n_atoms,
+        "hetero_atoms": structure.n_hetero_atoms,
+        "water_atoms": structure.n_water_atoms,
+        "altloc_atoms": structure.n_altloc_atoms,
+        "chains": [
+            {"chain": c.name, "residues": c.n_residues, "backbone_residues": c.n_backbone, "segments": c.n_segments}
+            for c in structure.chains
+        ],
+        "segments": segments,
+        "residues": structure.n_residues,
+        "secondary_structure": {"H": ss["H"], "E": ss["E"], "C": ss["C"]},
+        "secondary_structure_source": structure.ss_source,
+        "warnings": list(structure.warnings),
+    }
+
+
+def run_info(args: argparse.Namespace) -> int:
+    report = summary(load(args.file))
+    if args.json:
+        print(json.dumps(report, indent=2))
+        return 0
+    ss = report["secondary_structure"]
+    print(f"{report['file']}: {report['entry']} ({report['format']}), {report['title'] or 'no title'}")
+    print(f"  {report['atoms']} atoms ({report['hetero_atoms']} hetero, {report['water_atoms']} water, "
+          f"{report['altloc_atoms']} with altlocs); {report['models']} model(s), the first is used")
+    print(f"  {report['residues']} backbone residues: {ss['H']} helix, {ss['E']} sheet, {ss['C']} other "
+          f"(from {report['secondary_structure_source']})")
+    print(f"  {'chain':<6}{'seg':>4}  {'residues':>8}  {'from':<14}{'to':<14}{'max level':>10}")
+    for s in report["segments"]:
+        print(f"  {s['chain']:<6}{s['segment']:>4}  {s['residues']:>8}  {s['first']:<14}{s['last']:<14}"
+              f"{s['max_level_peptide']:>10.2f}")
+    return 0
+
+
+# ------------------------------------------------------------------------------ helpers
+
+
+def segment_number(structure: Structure, number: int) -> int:
+    """Position of segment ``number`` among the segments of its chain."""
+    chain = structure.segments[number].chain
+    return sum(1 for s in structure.segments[:number] if s.chain == chain)
+
+
+def chain_segments(structure: Structure, chain: str | None, segment: int | None = None) -> list[int]:
+    """Indices of the segments of ``chain`` (all if None), or just its ``segment``-th one."""
+    numbers = [i for i, s in enumerate(structure.segments) if chain is None or s.chain == chain]
+    if not numbers:
+        chains = ", ".join(dict.fromkeys(s.chain for s in structure.segments))
+        raise InputError(f"{structure.path}: no protein chain {chain!r} (chains: {chains})")
+    if segment is None:
+        return numbers
+    if not 0 <= segment < len(numbers):
+        raise InputError(f"{structure.path}: chain {chain} has {len(numbers)} segment(s); --segment {segment} is out of range")
+    return [numbers[segment]]

@@ -1,0 +1,2 @@
+"""The Qt editor: the document, undo commands, picking and dragging, the main window and how
+it is launched."""

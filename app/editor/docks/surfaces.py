@@ -1,0 +1,368 @@
+"""The surface panel: a globe, DNA cylinder, molecular surface, remeshed surface or density
+contour of the document's atoms, shown with the ribbon at any of its levels.
+
+A :class:`SurfaceLayer` builds surfaces with :func:`core.surfaces.levelled.build_surface` off the
+GUI thread (a one-worker executor; the result comes back through a queued Qt signal) and
+caches them per kind for the open structure, so moving the level slider or changing the
+colouring only asks the cached :class:`~core.surfaces.levelled.LevelledSurface` for another view. A
+view with the same triangles as the one on screen is written into the existing VTK arrays;
+any other goes under the same actor. Surfaces are computed from the atoms: after an edit
+the surface is stale until it is recomputed (or the edit undone). The
+:class:`SurfacePanel` dock only reads the layer and calls its mutators.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from concurrent.futures import Future, ThreadPoolExecutor
+
+import numpy as np
+import pyvista as pv
+from PySide6.QtCore import QObject, QSignalBlocker, Qt, Signal
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QProgressBar,
+    QPushButton,
+    QSlider,
+    QVBoxLayout,
+    QWidget,
+)
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+from app.editor.document import Document
+from app.polydata import scalar_style, to_polydata
+from core.protein.structure import Structure
+from core.surfaces.levelled import KINDS, UNITS, LevelledSurface, build_surface
+from core.surfaces.mesh import TriangleMesh
+
+KIND_NAMES = {"globe": "Globe", "dna": "DNA cylinder", "ses": "Molecular surface (SES)",
+              "remesh": "Remeshed surface", "map": "Density map (from the model)"}
+COLOURING_NAMES = {None: "Plain", "potential": "Electrostatic potential", "curvature": "Curvature",
+                   "bfactor": "B-factor"}
+STEPS_PER_LEVEL = 100
+"""Slider positions per level of a spline surface (fractional levels in steps of 0.01)."""
+SURFACE_COLOUR = (176, 196, 222)
+DEFAULT_OPACITY = 0.6
+SCALARS = "values"
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Built:
+    """A surface and the atom coordinates (n_atoms, 3), Å, it was built from."""
+
+    surface: LevelledSurface
+    coords: np.ndarray
+
+
+class SurfaceLayer(QObject):
+    """Builds, caches and draws the surfaces of a document's atoms into ``plotter``."""
+
+    updated = Signal()
+    """Anything shown about the surface changed: built, drawn, busy, stale or failed."""
+    _finished = Signal(object, str, object, object)
+
+    def __init__(self, document: Document, plotter: pv.BasePlotter) -> None:
+        super().__init__(document)
+        self.document = document
+        self.plotter = plotter
+        self.visible = False
+        self.kind = "globe"
+        self.level: float | None = None
+        """Requested level (None: the finest); views clip it to the surface's levels."""
+        self.colouring: str | None = None
+        self.opacity = DEFAULT_OPACITY
+        self.message = ""
+        """Why the current kind could not be built or coloured ('' when nothing failed)."""
+        self.mesh: pv.PolyData | None = None
+        self.actor: pv.Actor | None = None
+        self._drawn: tuple[LevelledSurface, str | None] | None = None
+        self._faces = np.empty((0, 3), dtype=np.int64)
+        self._cache: dict[str, Built] = {}
+        self._failed: dict[str, str] = {}
+        self._pending: set[str] = set()
+        self._structure = document.structure if document.model is not None else None
+        self._stale = False
+        self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="surface")
+        self._finished.connect(self._on_finished)
+        document.loaded.connect(self._on_loaded)
+        document.changed.connect(self._on_changed)
+
+    # ------------------------------------------------------------------ state
+
+    @property
+    def built(self) -> Built | None:
+        """The cached surface of the current kind, if built."""
+        return self._cache.get(self.kind)
+
+    @property
+    def busy(self) -> bool:
+        """Whether the current kind is being built."""
+        return self.kind in self._pending
+
+    @property
+    def stale(self) -> bool:
+        """Whether the atoms moved since the current kind was built."""
+        return self._stale
+
+    def shown_level(self) -> float:
+        """The level of the current surface that is (or would be) shown."""
+        surface = self.built.surface
+        level = surface.max_level if self.level is None else min(self.level, surface.max_level)
+        return level if surface.fractional else float(round(level))
+
+    # ------------------------------------------------------------------ mutators
+
+    def set_visible(self, on: bool) -> None:
+        """Show the surface of the current kind (building it first when needed) or hide it."""
+        self.visible = on
+        self._update()
+
+    def set_kind(self, kind: str) -> None:
+        if kind not in KINDS:
+            raise ValueError(f"kind must be one of {', '.join(KINDS)}; got {kind!r}")
+        self.kind = kind
+        self._update()
+
+    def set_level(self, level: float | None) -> None:
+        """Show ``level`` of the surface (None: the finest)."""
+        self.level = level
+        self._update()
+
+    def set_colouring(self, colouring: str | None) -> None:
+        """Colour by 'potential', 'curvature', 'bfactor' or one colour (None)."""
+        self.colouring = colouring
+        self._update()
+
+    def set_opacity(self, opacity: float) -> None:
+        self.opacity = float(np.clip(opacity, 0.0, 1.0))
+        if self.actor is not None:
+            self.actor.prop.opacity = self.opacity
+            self.plotter.render()
+
+    def recompute(self) -> None:
+        """Build the current kind again from the atoms as they are now."""
+        self._cache.pop(self.kind, None)
+        self._failed.pop(self.kind, None)
+        self._update()
+
+    def shutdown(self) -> None:
+        """Drop the builds not started and wait for the running one (call before the plotter closes)."""
+        self._executor.shutdown(wait=True, cancel_futures=True)
+
+    # ------------------------------------------------------------------ internals
+
+    def _update(self) -> None:
+        """Draw what the state asks for, starting a build when the surface is missing."""
+        self.message = self._failed.get(self.kind, "")
+        built = self.built
+        if self.visible and built is None and not self.busy and not self.message and self.document.model is not None:
+            self._build()
+        if self.visible and built is not None:
+            self._draw(built.surface)
+        elif self.actor is not None:
+            self.actor.SetVisibility(False)
+        self._stale = built is not None and not np.array_equal(built.coords, self.document.model.coords)
+        self.plotter.render()
+        self.updated.emit()
+
+    def _build(self) -> None:
+        structure, kind = self.document.structure, self.kind
+        coords = self.document.model.coords.copy()
+        atoms = dataclasses.replace(structure.atoms, coords=coords)
+        self._pending.add(kind)
+        future = self._executor.submit(build_surface, kind, atoms)
+        future.add_done_callback(lambda done: self._report(done, structure, kind, coords))
+
+    def _report(self, done: Future, structure: Structure, kind: str, coords: np.ndarray) -> None:
+        """Runs in the worker thread: hand the result to the GUI thread."""
+        if not done.cancelled():
+            self._finished.emit(structure, kind, coords, done.exception() or done.result())
+
+    def _on_finished(self, structure: Structure, kind: str, coords: np.ndarray, result: object) -> None:
+        if structure is not self._structure:
+            return  # built for a structure no longer open
+        self._pending.discard(kind)
+        if isinstance(result, (ValueError, MemoryError)):
+            self._failed[kind] = f"{KIND_NAMES[kind]}: {result}"
+        elif isinstance(result, BaseException):
+            raise result
+        else:
+            self._cache[kind] = Built(result, coords)
+        if kind == self.kind:
+            self._update()
+
+    def _draw(self, surface: LevelledSurface) -> None:
+        for colouring in dict.fromkeys((self.colouring, None)):  # plain when the colouring fails
+            try:
+                mesh, scalars = surface.view(self.shown_level(), colouring)
+                break
+            except ValueError as error:  # e.g. a map has no curvature
+                self.message = self.message or str(error)
+        else:
+            if self.actor is not None:
+                self.actor.SetVisibility(False)
+            return
+        polydata = to_polydata(mesh, scalars, SCALARS)
+        polydata.point_data["Normals"] = _vertex_normals(mesh)
+        polydata.point_data.active_normals_name = "Normals"
+        same_faces = self.mesh is not None and self._drawn == (surface, colouring) and \
+            np.array_equal(self._faces, mesh.faces)
+        if same_faces:  # another level of a spline net: new vertex values in the existing arrays
+            for name in ("Normals", SCALARS) if scalars is not None else ("Normals",):
+                _assign(self.mesh.GetPointData().GetArray(name), polydata.point_data[name])
+            _assign(self.mesh.GetPoints().GetData(), polydata.points)
+            self.mesh.Modified()
+        elif self.mesh is not None and self._drawn is not None and self._drawn[1] == colouring:
+            self.mesh.shallow_copy(polydata)  # other triangles under the same actor
+        else:
+            self.mesh = polydata
+            style = {"color": SURFACE_COLOUR} if scalars is None else {"scalars": SCALARS}
+            self.actor = self.plotter.add_mesh(self.mesh, name="surface", reset_camera=False, pickable=False,
+                                               show_scalar_bar=False, smooth_shading=False, render=False,
+                                               interpolation="phong", specular=0.3, specular_power=20.0, **style)
+        if scalars is not None:
+            cmap, clim = scalar_style(colouring, scalars)
+            self.actor.mapper.lookup_table.cmap = cmap
+            self.actor.mapper.scalar_range = clim
+        self.actor.prop.opacity = self.opacity
+        self.actor.SetVisibility(True)
+        self._drawn, self._faces = (surface, colouring), mesh.faces
+
+    def _on_loaded(self) -> None:
+        """A new structure, or a new ribbon kind: the scene removed every actor."""
+        self.mesh = self.actor = self._drawn = None
+        if self.document.structure is not self._structure:
+            self._structure = self.document.structure
+            self._cache.clear()
+            self._failed.clear()
+            self._pending.clear()
+        if self.visible:
+            self._update()
+
+    def _on_changed(self, _change: object) -> None:
+        built = self.built
+        stale = built is not None and not np.array_equal(built.coords, self.document.model.coords)
+        if stale != self._stale:
+            self._stale = stale
+            self.updated.emit()
+
+
+class SurfacePanel(QWidget):
+    """The dock: kind, level, colouring and opacity of the surface, and its figures."""
+
+    def __init__(self, layer: SurfaceLayer, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.layer = layer
+        self.show_box = QCheckBox("Show surface")
+        self.kind = QComboBox()
+        for kind, name in KIND_NAMES.items():
+            self.kind.addItem(name, kind)
+        self.slider = QSlider(Qt.Orientation.Horizontal)
+        self.level_text = QLabel()
+        self.colouring = QComboBox()
+        for colouring, name in COLOURING_NAMES.items():
+            self.colouring.addItem(name, colouring)
+        self.opacity = QSlider(Qt.Orientation.Horizontal)
+        self.opacity.setRange(0, 100)
+        self.opacity.setValue(round(layer.opacity * 100))
+        self.busy = QProgressBar()
+        self.busy.setRange(0, 0)  # an indeterminate "working" bar
+        self.busy.setTextVisible(False)
+        self.figures = QLabel()
+        self.figures.setWordWrap(True)
+        self.stale_text = QLabel("Computed from the atoms before the last edits.")
+        self.stale_text.setWordWrap(True)
+        self.recompute = QPushButton("Recompute")
+
+        level_row = QHBoxLayout()
+        level_row.addWidget(self.slider, 1)
+        level_row.addWidget(self.level_text)
+        form = QFormLayout()
+        form.addRow(self.show_box)
+        form.addRow("Kind", self.kind)
+        form.addRow("Level", level_row)
+        form.addRow("Colour", self.colouring)
+        form.addRow("Opacity", self.opacity)
+        layout = QVBoxLayout(self)
+        layout.addLayout(form)
+        layout.addWidget(self.busy)
+        layout.addWidget(self.figures)
+        layout.addWidget(self.stale_text)
+        layout.addWidget(self.recompute)
+        layout.addStretch(1)
+
+        self.show_box.toggled.connect(layer.set_visible)
+        self.kind.currentIndexChanged.connect(lambda: layer.set_kind(self.kind.currentData()))
+        self.slider.valueChanged.connect(self._slider_moved)
+        self.colouring.currentIndexChanged.connect(lambda: layer.set_colouring(self.colouring.currentData()))
+        self.opacity.valueChanged.connect(lambda value: layer.set_opacity(value / 100))
+        self.recompute.clicked.connect(layer.recompute)
+        layer.updated.connect(self.refresh)
+        self.refresh()
+
+    def refresh(self) -> None:
+        """Show the layer's state: busy, level range, figures of the mesh, staleness."""
+        layer = self.layer
+        built = layer.built
+        self.busy.setVisible(layer.busy)
+        self.stale_text.setVisible(layer.stale)
+        self.recompute.setVisible(layer.stale)
+        self.show_box.setEnabled(layer.document.model is not None)
+        with QSignalBlocker(self.show_box), QSignalBlocker(self.slider), QSignalBlocker(self.kind), \
+                QSignalBlocker(self.colouring):
+            self.show_box.setChecked(layer.visible)
+            self.kind.setCurrentIndex(list(KIND_NAMES).index(layer.kind))
+            self.colouring.setCurrentIndex(list(COLOURING_NAMES).index(layer.colouring))
+            if built is not None:
+                steps = STEPS_PER_LEVEL if built.surface.fractional else 1
+                self.slider.setRange(0, built.surface.max_level * steps)
+                self.slider.setValue(round(layer.shown_level() * steps))
+        self.slider.setEnabled(built is not None and built.surface.max_level > 0)
+        if layer.busy:
+            self.figures.setText(f"Building the {KIND_NAMES[layer.kind].lower()}…")
+        elif built is None:
+            self.level_text.setText("")
+            self.figures.setText(layer.message or "Not built yet: tick “Show surface”.")
+        else:
+            self.level_text.setText(f"{layer.shown_level():.2f} of {built.surface.max_level}")
+            self.figures.setText("\n".join([*self._figures(built.surface), layer.message]).strip())
+
+    def _figures(self, surface: LevelledSurface) -> list[str]:
+        layer = self.layer
+        lines = []
+        if layer.mesh is not None and layer.visible:
+            lines.append(f"{layer.mesh.n_cells} triangles, {layer.mesh.n_points} vertices")
+        errors = dict(surface.errors)
+        level = layer.shown_level()
+        if level in errors:
+            unit = "rms difference of map values" if surface.kind == "map" else "rms error (Å)"
+            lines.append(f"{unit} at this level: {errors[level]:.3f}")
+        if layer.visible and layer.colouring is not None and layer.mesh is not None and SCALARS in layer.mesh.point_data:
+            low, high = layer.actor.mapper.scalar_range
+            lines.append(f"{COLOURING_NAMES[layer.colouring]}: {low:.2f} … {high:.2f} {UNITS[layer.colouring]}")
+        return lines
+
+    def _slider_moved(self, value: int) -> None:
+        built = self.layer.built
+        if built is not None:
+            self.layer.set_level(value / (STEPS_PER_LEVEL if built.surface.fractional else 1))
+
+
+def _vertex_normals(mesh: TriangleMesh) -> np.ndarray:
+    """(n_vertices, 3) unit normals: the area-weighted mean of the adjacent face normals."""
+    a, b, c = (mesh.vertices[mesh.faces[:, k]] for k in range(3))
+    weighted = np.repeat(np.cross(b - a, c - a), 3, axis=0)
+    index, n = mesh.faces.ravel(), len(mesh.vertices)
+    normals = np.column_stack([np.bincount(index, weighted[:, j], minlength=n) for j in range(3)])
+    norm = np.linalg.norm(normals, axis=1, keepdims=True)
+    return np.divide(normals, norm, out=np.zeros_like(normals), where=norm > 0)
+
+
+def _assign(target: object, values: np.ndarray) -> None:
+    """Overwrite a VTK data array with ``values`` of the same shape, in place."""
+    vtk_to_numpy(target)[:] = values
+    target.Modified()  # type: ignore[attr-defined]

@@ -1,0 +1,316 @@
+"""The document: the one owner of the structure being edited (a QObject without widgets).
+
+It holds the :class:`~core.protein.model.EditableModel`, the slider level, the chosen segment, the
+picked control point, the file names and the undo stack. Only its mutators change that
+state, and each emits a signal that says what changed, so views can subscribe and touch
+only what they must. Every edit reaches the model through an undo command
+(:class:`app.editor.commands.EditCommand`); a drag shows previews relative to the state at the
+start of the gesture and pushes one command when it ends.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+from PySide6.QtCore import QObject, Signal
+from PySide6.QtGui import QUndoStack
+
+from app.editor.commands import EditCommand
+from app.editor.scene.curves import LevelCurve, SegmentPath
+from app.editor.scene.molecule import ca_rows
+from core.geometry.regularize import FLANK, regularize_region, regularized
+from core.protein.model import Edit, EditableModel
+from core.protein.reading import read_structure
+from core.protein.ribbon import RibbonKind
+from core.protein.structure import Structure
+
+LEVELS_BELOW_MAX = 2
+"""A file opens at the integer level nearest to ``log2 N - 2`` (a quarter of the detail:
+Carson's colleagues still recognised the fold there)."""
+
+
+class Change(NamedTuple):
+    """What one edit (or its undo) moved."""
+
+    segment: int
+    residues: np.ndarray
+    """Residue indices within the segment."""
+    rows: np.ndarray
+    """Rows of the coordinate array."""
+
+
+class Pick(NamedTuple):
+    """A picked control point of the curve shown at the current level."""
+
+    index: int
+    residues: np.ndarray
+    """Residues (within the segment) that moving it would move."""
+
+
+class Document(QObject):
+    """The edited structure and everything the views show about it."""
+
+    loaded = Signal()
+    """A structure was opened (or the ribbon kind changed): everything is new."""
+    changed = Signal(object)
+    """A :class:`Change`: atoms and the ribbon of one segment moved."""
+    levelChanged = Signal()
+    """The slider level or the multiresolution switch changed."""
+    segmentChanged = Signal()
+    picked = Signal()
+    """The picked control point changed (see :attr:`pick`)."""
+    fileChanged = Signal()
+    """The file name, the save target or the modified state changed."""
+
+    def __init__(self, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self.undo_stack = QUndoStack(self)
+        self.undo_stack.cleanChanged.connect(self.fileChanged)
+        self.model: EditableModel | None = None
+        self.paths: list[SegmentPath] = []
+        self.ca_rows = np.empty(0, dtype=np.int64)
+        """Row of the coordinates holding each backbone residue's Cα (residue-table order)."""
+        self.path: Path | None = None
+        self.save_path: Path | None = None
+        """Where Save writes without asking; None until Save As chose a file."""
+        self.segment = 0
+        self.level = 0.0
+        self.multiresolution = True
+        self.pick: Pick | None = None
+        self.regularize_on_release = True
+        """A drag's undo step holds the edit followed by :func:`core.geometry.regularize.regularized`."""
+        self.regularize_while_dragging = False
+        """Every preview is regularized (40–110 ms a step on ubiquitin: off by default)."""
+        self._curves: dict[int, LevelCurve] = {}
+        self._preview: Edit | None = None
+
+    # ------------------------------------------------------------------ state
+
+    @property
+    def structure(self) -> Structure:
+        return self._model.structure
+
+    @property
+    def kind(self) -> RibbonKind:
+        return self._model.kind
+
+    @property
+    def modified(self) -> bool:
+        """Edits not saved yet."""
+        return self.model is not None and not self.undo_stack.isClean()
+
+    @property
+    def max_level(self) -> float:
+        """Top of the slider for the current segment, ``log2 N``."""
+        return self._model.ribbons[self.segment].max_level
+
+    def shown_level(self, segment: int | None = None) -> float:
+        """Level at which ``segment`` (default: the current one) is shown and edited."""
+        ribbon = self._model.ribbons[self.segment if segment is None else segment]
+        return min(self.level, ribbon.max_level) if self.multiresolution else ribbon.max_level
+
+    def level_curve(self, segment: int | None = None) -> LevelCurve:
+        """The curve of ``segment`` (default: the current one) at its shown level (cached)."""
+        segment = self.segment if segment is None else segment
+        if segment not in self._curves:
+            ribbon = self._model.ribbons[segment]
+            self._curves[segment] = self.paths[segment].level_curve(ribbon, self.shown_level(segment))
+        return self._curves[segment]
+
+    def deviation(self, segment: int | None = None) -> float:
+        """rms |Cα − C^r| (Å) of ``segment`` at its shown level, with the current Cα positions."""
+        segment = self.segment if segment is None else segment
+        ca = self._model.coords[self.ca_rows[self.structure.segments[segment].residue_index]]
+        offset = self.level_curve(segment).residue_points - ca
+        return float(np.sqrt(np.mean(np.einsum("ij,ij->i", offset, offset))))
+
+    def labels(self, segment: int | None = None) -> tuple[str, ...]:
+        """Residue labels of ``segment`` (default: the current one), e.g. ``'A:LYS48'``."""
+        return self.structure.segments[self.segment if segment is None else segment].labels
+
+    def segment_label(self, segment: int) -> str:
+        """E.g. ``'A  MET1–GLY76 (76 residues)'``."""
+        labels = self.labels(segment)
+        chain = self.structure.segments[segment].chain
+        return f"{chain}  {labels[0].split(':')[1]}–{labels[-1].split(':')[1]} ({len(labels)} residues)"
+
+    def residue_range(self, residues: np.ndarray, segment: int | None = None) -> str:
+        """E.g. ``'A:LYS6–A:THR9'`` (or ``'none'``)."""
+        if len(residues) == 0:
+            return "none"
+        labels = self.labels(segment)
+        first, last = labels[int(residues[0])], labels[int(residues[-1])]
+        return first if first == last else f"{first}–{last}"
+
+    # ------------------------------------------------------------------ mutators
+
+    def open(self, path: Path, kind: RibbonKind | str = RibbonKind.PEPTIDE) -> None:
+        """Read ``path`` and make it the document (raises :class:`core.protein.structure.StructureError`)."""
+        self._set_model(EditableModel(read_structure(path), kind))
+        self.path = Path(path)
+        self.save_path = None
+        self.fileChanged.emit()
+
+    def set_kind(self, kind: RibbonKind | str) -> None:
+        """Switch between the peptide-plane and the Cα ribbon; only without edits to undo."""
+        if RibbonKind(kind) is self.kind:
+            return
+        if self.undo_stack.index() > 0:
+            raise ValueError("the ribbon kind can change only while there are no edits to undo")
+        self._set_model(EditableModel(self.structure, kind))
+
+    def set_level(self, level: float) -> None:
+        """Set the slider level (clipped to ``[0, log2 N]`` of the current segment)."""
+        level = float(np.clip(level, 0.0, self.max_level))
+        if level != self.level:
+            self.level = level
+            self._level_changed()
+
+    def set_multiresolution(self, on: bool) -> None:
+        """Multiresolution analysis on (the slider level) or off (every segment at full resolution)."""
+        if on != self.multiresolution:
+            self.multiresolution = on
+            self._level_changed()
+
+    def set_segment(self, segment: int) -> None:
+        """Choose the segment whose control points are shown and edited."""
+        if not 0 <= segment < len(self._model.ribbons):
+            raise ValueError(f"segment must be in [0, {len(self._model.ribbons) - 1}]; got {segment}")
+        if segment != self.segment:
+            self.segment = segment
+            self.level = min(self.level, self.max_level)
+            self._set_pick(None)
+            self.segmentChanged.emit()
+            self._level_changed()
+
+    def pick_point(self, index: int | None) -> None:
+        """Pick control point ``index`` of the current level curve (None: nothing)."""
+        if index is None:
+            self._set_pick(None)
+            return
+        probe = self._model.move_point(self.segment, self.shown_level(), index, np.array([1.0, 0.0, 0.0]))
+        self._set_pick(Pick(index, probe.residues))
+
+    @property
+    def dragging(self) -> bool:
+        """Whether a drag's edit is being previewed (not yet an undo step)."""
+        return self._preview is not None
+
+    def preview_move(self, index: int, displacement: np.ndarray) -> None:
+        """Show control point ``index`` moved by ``displacement`` (Å) from where the drag began."""
+        self._preview_edit(lambda: self._model.move_point(self.segment, self.shown_level(), index, displacement))
+
+    def preview_tug(self, u: float, displacement: np.ndarray) -> None:
+        """Show the level curve dragged at parameter ``u`` by ``displacement`` (Å) from the drag start."""
+        self._preview_edit(lambda: self._model.tug(self.segment, self.shown_level(), u, displacement))
+
+    def set_regularization(self, *, on_release: bool | None = None, while_dragging: bool | None = None) -> None:
+        """Regularize drags when they end and/or at every preview (None: leave as it is)."""
+        if on_release is not None:
+            self.regularize_on_release = on_release
+        if while_dragging is not None:
+            self.regularize_while_dragging = while_dragging
+
+    def finish_drag(self, text: str) -> None:
+        """End a drag: the previewed edit (regularized if asked) becomes one undo step named
+        ``text`` (none if nothing moved)."""
+        edit, self._preview = self._preview, None
+        if edit is not None and not np.array_equal(edit.old_points, edit.new_points):
+            if self.regularize_on_release and not self.regularize_while_dragging:  # else the preview is regularized
+                edit = regularized(self._model, edit)
+            self.undo_stack.push(EditCommand(self, edit, text))
+
+    def cancel_drag(self) -> None:
+        """End a drag without an edit: put everything back where it was."""
+        edit, self._preview = self._preview, None
+        if edit is not None:
+            self.revert_edit(edit)
+
+    def regularize_region(self, residues: np.ndarray) -> None:
+        """Regularize ``residues`` (indices within the current segment) and up to FLANK neighbours
+        on each side as one undo step: ideal junctions, on the current curve, and no clash
+        that the structure as read did not have."""
+        edit = regularize_region(self._model, self.segment, residues, flank=FLANK)
+        if not np.array_equal(edit.old_coords, edit.new_coords):
+            self.undo_stack.push(EditCommand(self, edit, f"Regularize {self.residue_range(edit.residues)}"))
+
+    def apply_edit(self, edit: Edit) -> None:
+        """Carry out ``edit`` (undo commands call this)."""
+        self._model.apply(edit)
+        self._edited(Change(edit.segment, edit.residues, edit.rows))
+
+    def revert_edit(self, edit: Edit) -> None:
+        """Undo ``edit`` exactly (undo commands call this)."""
+        self._model.revert(edit)
+        self._edited(Change(edit.segment, edit.residues, edit.rows))
+
+    def save(self, path: Path, *, overwrite: bool = False) -> Path:
+        """Write the edited structure (PDB or mmCIF by the extension) atomically; it becomes the
+        document's file and Save's target. Raises StructureError, FileExistsError or OSError."""
+        written = self._model.save(path, overwrite=overwrite)
+        self.path = self.save_path = Path(written)
+        self.undo_stack.setClean()
+        self.fileChanged.emit()
+        return written
+
+    # ------------------------------------------------------------------ internals
+
+    @property
+    def _model(self) -> EditableModel:
+        if self.model is None:
+            raise RuntimeError("no structure is open")
+        return self.model
+
+    def _set_model(self, model: EditableModel) -> None:
+        self.undo_stack.clear()
+        self.model = model
+        self.paths = [SegmentPath(ribbon) for ribbon in model.ribbons]
+        self.ca_rows = ca_rows(model.structure)
+        self.segment = 0
+        self.level = float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
+        self.pick = None
+        self._preview = None
+        self._curves.clear()
+        self.loaded.emit()
+
+    def _preview_edit(self, plan: Callable[[], Edit]) -> None:
+        previous = self._preview
+        if previous is not None:
+            self._model.revert(previous)
+        edit = plan()
+        if self.regularize_while_dragging:
+            edit = regularized(self._model, edit)
+        self._model.apply(edit)
+        self._preview = edit
+        if previous is None:
+            self._edited(Change(edit.segment, edit.residues, edit.rows))
+        else:  # what the last preview moved must be redrawn too
+            n_residues, n_atoms = len(self.paths[edit.segment].residue_u), len(self._model.coords)
+            self._edited(Change(edit.segment, _union(previous.residues, edit.residues, n_residues),
+                                _union(previous.rows, edit.rows, n_atoms)))
+
+    def _edited(self, change: Change) -> None:
+        self._curves.pop(change.segment, None)
+        self.changed.emit(change)
+
+    def _level_changed(self) -> None:
+        self._curves.clear()
+        self._set_pick(None)
+        self.levelChanged.emit()
+
+    def _set_pick(self, pick: Pick | None) -> None:
+        if pick is None and self.pick is None:
+            return
+        self.pick = pick
+        self.picked.emit()
+
+
+def _union(a: np.ndarray, b: np.ndarray, size: int) -> np.ndarray:
+    """Sorted union of two index arrays into ``range(size)`` (a mask beats hashing here)."""
+    mask = np.zeros(size, dtype=bool)
+    mask[a] = True
+    mask[b] = True
+    return np.flatnonzero(mask)

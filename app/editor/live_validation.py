@@ -1,0 +1,105 @@
+"""Validation that follows the document: one full check per structure, local checks per edit.
+
+:class:`LiveValidation` validates the whole structure when it is loaded; after that each
+:class:`~app.editor.document.Change` (a drag preview, an undo, a regularization) re-checks only
+the residues that moved, with what they touch, and folds that local report into the
+current one (:meth:`core.geometry.validation.ValidationReport.updated`); a change that moves more
+than half of the residues is checked in full. Every atom outside a change is where it was
+when the report described it, so the folded report is the report of the current
+coordinates. Views follow :attr:`LiveValidation.updated`.
+
+During a drag the report is brought up to date from the event loop, at most every
+:data:`DRAG_INTERVAL_MS` (the residues moved meanwhile are checked together), so a drag
+step does not pay for a check; every other change, the end of a drag included, is
+checked at once.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from PySide6.QtCore import QObject, QTimer, Signal
+
+from app.editor.document import Change, Document
+from core.geometry.validation import ValidationReport, validate
+
+LOCAL_FRACTION = 0.5
+"""A change of more than this fraction of the residues is checked in full (as fast, and exact)."""
+
+DRAG_INTERVAL_MS = 100
+"""Shortest time between two checks while a drag is previewed."""
+
+
+class LiveValidation(QObject):
+    """The validation report of a :class:`Document`'s current coordinates."""
+
+    updated = Signal()
+    """:attr:`report` describes new coordinates (or a new structure)."""
+
+    def __init__(self, document: Document) -> None:
+        super().__init__(document)
+        self.document = document
+        self.report: ValidationReport | None = None
+        self.elapsed_ms = 0.0
+        """Time of the last check, ms (a full one after loading, a local one after a change)."""
+        self.local = False
+        """Whether the last check was a local one."""
+        self.late = False
+        """Whether the last check was a drag's deferred one, run after its change was drawn."""
+        self._pending: np.ndarray | None = None  # residues (table rows) moved since the last check
+        self._finished = 0.0
+        self._timer = QTimer(self)
+        self._timer.setSingleShot(True)
+        self._timer.timeout.connect(lambda: self._check_pending(late=True))
+        document.loaded.connect(self._check_all)
+        document.changed.connect(self._check_change)
+        if document.model is not None:
+            self._check_all()
+
+    @property
+    def pending(self) -> bool:
+        """Whether moved residues wait for their (deferred) check."""
+        return self._pending is not None
+
+    def check_now(self) -> None:
+        """Run a check that waits for the drag interval at once (if there is one)."""
+        self._check_pending()
+
+    def _check_all(self, late: bool = False) -> None:
+        self._timer.stop()
+        self._pending = None
+        start = time.perf_counter()
+        self.report = validate(self.document.structure, self.document.model.coords)
+        self._done(start, local=False, late=late)
+
+    def _check_change(self, change: Change) -> None:
+        residues = self.document.structure.segments[change.segment].residue_index[change.residues]
+        self._pending = residues if self._pending is None else np.union1d(self._pending, residues)
+        if self.document.dragging:  # checked in an event-loop turn of its own, not in the drag step
+            if not self._timer.isActive():
+                wait = DRAG_INTERVAL_MS - 1e3 * (time.perf_counter() - self._finished)
+                self._timer.start(max(0, int(wait) + 1))
+            return
+        self._check_pending()
+
+    def _check_pending(self, late: bool = False) -> None:
+        residues = self._pending
+        if residues is None:
+            return
+        if len(residues) > LOCAL_FRACTION * self.document.structure.n_residues:
+            self._check_all(late)
+            return
+        self._timer.stop()
+        self._pending = None
+        start = time.perf_counter()
+        local = validate(self.document.structure, self.document.model.coords, residues=residues)
+        self.report = self.report.updated(local)
+        self._done(start, local=True, late=late)
+
+    def _done(self, start: float, local: bool, late: bool) -> None:
+        self._finished = time.perf_counter()
+        self.elapsed_ms = 1e3 * (self._finished - start)
+        self.local = local
+        self.late = late
+        self.updated.emit()

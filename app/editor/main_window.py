@@ -1,0 +1,446 @@
+"""The editor's main window: the 3D view, the docks, menus, toolbar and status bar.
+
+The window wires the pieces together: a :class:`~app.editor.document.Document`, the
+:class:`~app.editor.scene.scene.Scene` drawing it into a pyvistaqt ``QtInteractor``, the
+:class:`~app.editor.picking.PointerAdapter` feeding mouse events to the
+:class:`~app.editor.drag.DragController`, and the dock panels. It also owns the file dialogs
+(open, save, recent files, drag-and-drop, image export) and asks before unsaved edits
+would be lost. The ``app`` package sets ``QT_API`` before this module imports pyvistaqt.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+from PySide6.QtCore import QPoint, QSettings, Qt
+from PySide6.QtGui import (
+    QAction,
+    QActionGroup,
+    QCloseEvent,
+    QDragEnterEvent,
+    QDropEvent,
+    QImage,
+    QKeySequence,
+    QPainter,
+)
+from PySide6.QtWidgets import (
+    QApplication,
+    QDockWidget,
+    QFileDialog,
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QScrollArea,
+    QStyle,
+    QUndoView,
+    QWidget,
+)
+from pyvistaqt import QtInteractor
+
+from app import EXAMPLES_DIR
+from app.editor.docks.comparison import ComparisonPanel
+from app.editor.docks.panels import DisplayPanel, RibbonDimensionPanel
+from app.editor.docks.surfaces import SurfaceLayer, SurfacePanel
+from app.editor.docks.validation import ValidationPanel
+from app.editor.document import Document
+from app.editor.drag import DragController, Mode, PointerEvent
+from app.editor.live_validation import LiveValidation
+from app.editor.picking import PRIORITY, PointerAdapter
+from app.editor.scene.overlay import Comparison, ComparisonView
+from app.editor.scene.scene import Layer, Scene
+from app.editor.scene.validation_markers import ValidationMarkers
+from core.protein.structure import StructureError
+
+APP_NAME = "ribbonwave"
+RECENT_KEY = "recentFiles"
+MAX_RECENT = 8
+STRUCTURE_FILTER = "Structures (*.pdb *.ent *.cif *.mmcif *.gz);;All files (*)"
+SAVE_FILTERS = {"PDB (*.pdb *.pdb.gz *.ent)": ".pdb", "mmCIF (*.cif *.cif.gz *.mmcif)": ".cif"}
+SAVE_SUFFIXES = (".pdb", ".ent", ".cif", ".mmcif", ".pdb.gz", ".ent.gz", ".cif.gz", ".mmcif.gz")
+
+
+class MainWindow(QMainWindow):
+    """The editor window on a :class:`Document` (a new, empty one when none is given)."""
+
+    def __init__(self, document: Document | None = None, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.document = document if document is not None else Document()
+        self.document.setParent(self)
+        self.settings = QSettings(APP_NAME, APP_NAME)
+        self.resize(1400, 900)
+        self.setAcceptDrops(True)
+
+        self.plotter = QtInteractor(self, auto_update=False)
+        self.plotter.setAcceptDrops(False)  # dropped files go to the window, which opens them
+        self.plotter.iren.clear_key_event_callbacks()  # no pyvista key bindings ('q' would close the view)
+        self._swallow_style_keys()
+        self.plotter.enable_anti_aliasing("fxaa")
+        self._smooth_still_frames_only()
+        self.setCentralWidget(self.plotter)
+        self.validation = LiveValidation(self.document)  # before the scene: its report is new when the scene renders
+        self.scene = Scene(self.document, self.plotter)
+        self.markers = ValidationMarkers(self.validation, self.scene)
+        self.controller = DragController(self.document)
+        self.pointer = PointerAdapter(self.plotter, self._on_pointer)
+
+        self.dimension_panel = RibbonDimensionPanel(self.document)
+        self.display_panel = DisplayPanel(self.scene)
+        self.comparison = Comparison(self.document)  # after the scene: it redraws once the scene is rebuilt
+        self.comparison_view = ComparisonView(self.comparison, self.plotter)
+        self.comparison_panel = ComparisonPanel(self.comparison)
+        self.validation_panel = ValidationPanel(self.validation)
+        self.surface_layer = SurfaceLayer(self.document, self.plotter)  # after the scene, which clears the view on load
+        self.surface_panel = SurfacePanel(self.surface_layer)
+        self.history = QUndoView(self.document.undo_stack)
+        self.history.setEmptyLabel("<structure as read>")
+        docks = [self._dock("Ribbon dimension", self.dimension_panel),
+                 self._dock("Display", _scrolled(self.display_panel)),
+                 self._dock("Undo history", self.history), self._dock("Validation", _scrolled(self.validation_panel)),
+                 self._dock("Compared structures", self.comparison_panel)]
+        docks.append(self._dock("Surface", self.surface_panel))
+        self.tabifyDockWidget(docks[1], docks[-1])  # beside the ribbon's display options
+        docks[1].raise_()
+        self.tabifyDockWidget(docks[2], docks[3])  # validation and history share a place: the window stays small
+        self.tabifyDockWidget(docks[2], docks[4])  # and the compared structures
+        docks[3].raise_()
+        self._create_actions()
+        self._create_menus(docks)
+        self._create_status_bar()
+
+        self.document.fileChanged.connect(self._update_title)
+        self.document.loaded.connect(self._update_status)
+        self.document.levelChanged.connect(self._update_status)
+        self.document.segmentChanged.connect(self._update_status)
+        self.document.picked.connect(self._update_status)
+        self.document.picked.connect(self._update_regularize_action)
+        self._update_title()
+        self._update_status()
+
+    # ------------------------------------------------------------------ files
+
+    def open_file(self, path: Path) -> bool:
+        """Open ``path`` after asking about unsaved edits; a bad file is reported in a dialog."""
+        if not self.maybe_save():
+            return False
+        try:
+            self.document.open(Path(path))
+        except StructureError as error:
+            QMessageBox.critical(self, APP_NAME, str(error))
+            return False
+        self._add_recent(Path(path))
+        return True
+
+    def save(self) -> bool:
+        """Save to the file chosen by the last Save As; the first Save of a file asks where."""
+        if self.document.model is None:
+            return False
+        if self.document.save_path is None:
+            return self.save_as()
+        return self._write(self.document.save_path)
+
+    def save_as(self) -> bool:
+        """Ask for a file name (PDB or mmCIF by its extension) and save there."""
+        if self.document.model is None:
+            return False
+        source = self.document.path
+        folder = Path.home() if source is None or source.parent == EXAMPLES_DIR else source.parent
+        stem = source.name.split(".")[0] if source is not None else "structure"
+        suffix = ".cif" if self.document.structure.source_format == "mmcif" else ".pdb"
+        name, chosen = QFileDialog.getSaveFileName(self, "Save As", str(folder / f"{stem}_edited{suffix}"),
+                                                   ";;".join(SAVE_FILTERS))
+        if not name:
+            return False
+        path = Path(name)
+        if not path.name.lower().endswith(SAVE_SUFFIXES):  # the dialog asked about the name without it
+            path = path.with_name(path.name + SAVE_FILTERS.get(chosen, suffix))
+            replace = QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No
+            if path.exists() and QMessageBox.question(self, APP_NAME, f"{path.name} exists. Replace it?",
+                                                      replace) != QMessageBox.StandardButton.Yes:
+                return False
+        return self._write(path)
+
+    def export_image(self, path: Path | None = None) -> bool:
+        """Save the 3D view as a PNG image (asks for the name when ``path`` is None)."""
+        if path is None:
+            name, _ = QFileDialog.getSaveFileName(self, "Export Image", str(Path.home() / "ribbonwave.png"),
+                                                  "PNG image (*.png)")
+            if not name:
+                return False
+            path = Path(name) if name.lower().endswith(".png") else Path(name + ".png")
+        if not self._view_image().save(str(path), "PNG"):
+            QMessageBox.critical(self, APP_NAME, f"cannot write {path}")
+            return False
+        return True
+
+    def recent_files(self) -> list[str]:
+        """Files opened or saved lately, newest first (absolute paths)."""
+        value = self.settings.value(RECENT_KEY, [])
+        return [value] if isinstance(value, str) else list(value or [])
+
+    def maybe_save(self) -> bool:
+        """True when it is fine to drop the document: no unsaved edits, saved, or discarded."""
+        if not self.document.modified:
+            return True
+        name = self.document.path.name if self.document.path else "the structure"
+        answer = QMessageBox.question(
+            self, APP_NAME, f"Save the changes to {name}?",
+            QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel,
+        )
+        if answer == QMessageBox.StandardButton.Save:
+            return self.save()
+        return answer == QMessageBox.StandardButton.Discard
+
+    def save_screenshot(self, path: Path) -> None:
+        """Render the window, 3D view included, to a PNG image (raises OSError)."""
+        if not self.grab_window().save(str(path), "PNG"):
+            raise OSError(f"cannot write {path}")
+
+    def grab_window(self) -> QImage:
+        """An image of the whole window with the freshly rendered 3D view painted in."""
+        image = self.grab().toImage()
+        view = self._view_image()
+        painter = QPainter(image)
+        corner = self.plotter.mapTo(self, QPoint(0, 0))
+        painter.drawImage(corner, view.scaled(self.plotter.size()))
+        painter.end()
+        return image
+
+    # ------------------------------------------------------------------ events
+
+    def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802 (Qt override)
+        """Ask about unsaved edits; then release the VTK render window with the window."""
+        if not self.maybe_save():
+            event.ignore()
+            return
+        self.surface_layer.shutdown()
+        self.pointer.close()
+        self.plotter.close()
+        super().closeEvent(event)
+
+    def dragEnterEvent(self, event: QDragEnterEvent) -> None:  # noqa: N802 (Qt override)
+        if any(url.isLocalFile() for url in event.mimeData().urls()):
+            event.acceptProposedAction()
+
+    def dropEvent(self, event: QDropEvent) -> None:  # noqa: N802 (Qt override)
+        files = [Path(url.toLocalFile()) for url in event.mimeData().urls() if url.isLocalFile()]
+        if files:
+            event.acceptProposedAction()
+            self.open_file(files[0])
+
+    # ------------------------------------------------------------------ building
+
+    def _dock(self, title: str, widget: QWidget) -> QDockWidget:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(title)
+        dock.setWidget(widget)
+        self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
+        return dock
+
+    def _create_actions(self) -> None:
+        style = self.style()
+        icon = style.standardIcon
+        pixmap = QStyle.StandardPixmap
+        self.open_action = self._action("&Open…", QKeySequence.StandardKey.Open, self._open_dialog,
+                                        icon(pixmap.SP_DialogOpenButton))
+        self.save_action = self._action("&Save", QKeySequence.StandardKey.Save, self.save,
+                                        icon(pixmap.SP_DialogSaveButton))
+        self.save_as_action = self._action("Save &As…", QKeySequence.StandardKey.SaveAs, self.save_as)
+        self.export_action = self._action("&Export Image…", QKeySequence("Ctrl+E"), lambda: self.export_image())
+        self.quit_action = self._action("&Quit", QKeySequence.StandardKey.Quit, self.close)
+        stack = self.document.undo_stack
+        self.undo_action = stack.createUndoAction(self, "&Undo")
+        self.undo_action.setShortcut(QKeySequence.StandardKey.Undo)
+        self.undo_action.setIcon(icon(pixmap.SP_ArrowBack))
+        self.undo_action.setIconText("Undo")  # the toolbar keeps a short label; the menu names the edit
+        self.redo_action = stack.createRedoAction(self, "&Redo")
+        self.redo_action.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence.StandardKey.Redo])
+        self.redo_action.setIcon(icon(pixmap.SP_ArrowForward))
+        self.redo_action.setIconText("Redo")
+        self.cancel_action = self._action("Cancel Drag / Deselect", QKeySequence(Qt.Key.Key_Escape), self._cancel)
+        self.regularize_action = self._action("Re&gularize Region", QKeySequence("Ctrl+G"), self._regularize_region)
+        self.regularize_action.setToolTip("Ideal peptide junctions and no new clashes for the residues of the picked "
+                                          "point and three on each side (one undo step)")
+        self.regularize_action.setEnabled(False)
+        self.reset_view_action = self._action("&Reset View", QKeySequence("Ctrl+R"), self._reset_view,
+                                              icon(pixmap.SP_BrowserReload))
+        self.mode_actions = QActionGroup(self)
+        for mode, key in ((Mode.POINT, "M"), (Mode.CURVE, "T")):
+            action = self._action(mode.value[0].upper() + mode.value[1:], QKeySequence(key),
+                                  lambda _=False, mode=mode: setattr(self.controller, "mode", mode))
+            action.setCheckable(True)
+            action.setChecked(mode is self.controller.mode)
+            self.mode_actions.addAction(action)
+
+    def _action(self, text: str, shortcut: QKeySequence | QKeySequence.StandardKey, slot: object,
+                icon: object = None) -> QAction:
+        action = QAction(text, self)
+        action.setShortcut(shortcut)
+        action.triggered.connect(slot)
+        if icon is not None:
+            action.setIcon(icon)
+        self.addAction(action)  # shortcuts work wherever the focus is, the 3D view included
+        return action
+
+    def _create_menus(self, docks: list[QDockWidget]) -> None:
+        menu = self.menuBar()
+        file_menu = menu.addMenu("&File")
+        file_menu.addAction(self.open_action)
+        self.recent_menu = file_menu.addMenu("Open &Recent")
+        self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
+        file_menu.addAction("Add Structures for &Comparison…", self.comparison_panel.add_dialog)
+        file_menu.addSeparator()
+        file_menu.addActions([self.save_action, self.save_as_action, self.export_action])
+        file_menu.addSeparator()
+        file_menu.addAction(self.quit_action)
+        edit_menu = menu.addMenu("&Edit")
+        edit_menu.addActions([self.undo_action, self.redo_action, self.cancel_action])
+        edit_menu.addSeparator()
+        edit_menu.addActions(self.mode_actions.actions())
+        edit_menu.addSeparator()
+        edit_menu.addAction(self.regularize_action)
+        view_menu = menu.addMenu("&View")
+        view_menu.addAction(self.reset_view_action)
+        view_menu.addSeparator()
+        view_menu.addActions([dock.toggleViewAction() for dock in docks])
+        toolbar = self.addToolBar("Main")
+        toolbar.setObjectName("Main")
+        toolbar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+        toolbar.addActions([self.open_action, self.save_action])
+        toolbar.addSeparator()
+        toolbar.addActions([self.undo_action, self.redo_action])
+        toolbar.addSeparator()
+        toolbar.addActions(self.mode_actions.actions())
+        toolbar.addSeparator()
+        toolbar.addAction(self.reset_view_action)
+
+    def _create_status_bar(self) -> None:
+        self.status_labels = {key: QLabel() for key in ("file", "segment", "level", "pick")}
+        for key, label in self.status_labels.items():
+            self.statusBar().addWidget(label, 1 if key == "pick" else 0)
+
+    def _swallow_style_keys(self) -> None:
+        """Keep VTK's one-letter camera-style keys ('w' wireframe, 'e' exit, ...) away from the view."""
+        interactor = self.plotter.iren.interactor
+        tag = interactor.AddObserver("CharEvent", lambda caller, _: caller.GetCommand(tag).SetAbortFlag(1), PRIORITY)
+
+    def _smooth_still_frames_only(self) -> None:
+        """Anti-alias the frames drawn at rest, not those drawn while the camera turns (it costs
+        half of a frame with software OpenGL); drags do the same in :meth:`_on_pointer`."""
+        style = self.plotter.iren.interactor.GetInteractorStyle()
+        style.AddObserver("StartInteractionEvent", lambda *_: self.plotter.renderer.SetUseFXAA(False))
+        style.AddObserver("EndInteractionEvent", lambda *_: self._end_interaction())
+
+    def _end_interaction(self) -> None:
+        self.plotter.renderer.SetUseFXAA(True)
+        self.plotter.render()
+
+    # ------------------------------------------------------------------ slots
+
+    def _on_pointer(self, event: PointerEvent) -> bool:
+        grabs = Layer.CONTROL_POINTS if self.controller.mode is Mode.POINT else Layer.CURVE
+        if event.kind == "press" and grabs not in self.scene.layers:
+            return False  # what is hidden cannot be grabbed: the press turns the camera
+        if event.kind == "release" and self.controller.dragging:
+            self.plotter.renderer.SetUseFXAA(True)  # the frame after the drag is a still one
+            with _busy():  # the release regularizes: a hard edit takes a few tenths of a second
+                return self.controller.handle(event)
+        used = self.controller.handle(event)
+        if used and event.kind == "press":
+            self.plotter.renderer.SetUseFXAA(False)
+        return used
+
+    def _cancel(self) -> None:
+        if self.controller.dragging:
+            self.controller.cancel()
+        elif self.document.model is not None:
+            self.document.pick_point(None)
+
+    def _regularize_region(self) -> None:
+        if self.document.pick is not None:
+            with _busy():
+                self.document.regularize_region(self.document.pick.residues)
+
+    def _update_regularize_action(self) -> None:
+        self.regularize_action.setEnabled(self.document.pick is not None)
+
+    def _reset_view(self) -> None:
+        self.scene.reset_camera()
+        self.plotter.render()
+
+    def _open_dialog(self) -> None:
+        folder = str(self.document.path.parent) if self.document.path else str(Path.home())
+        name, _ = QFileDialog.getOpenFileName(self, "Open Structure", folder, STRUCTURE_FILTER)
+        if name:
+            self.open_file(Path(name))
+
+    def _write(self, path: Path) -> bool:
+        try:
+            self.document.save(path, overwrite=True)
+        except (StructureError, OSError) as error:
+            QMessageBox.critical(self, APP_NAME, str(error))
+            return False
+        self._add_recent(path)
+        return True
+
+    def _add_recent(self, path: Path) -> None:
+        name = str(path.resolve())
+        files = [name] + [f for f in self.recent_files() if f != name]
+        self.settings.setValue(RECENT_KEY, files[:MAX_RECENT])
+
+    def _fill_recent_menu(self) -> None:
+        self.recent_menu.clear()
+        for name in self.recent_files():
+            action = self.recent_menu.addAction(name)
+            action.triggered.connect(lambda _=False, name=name: self.open_file(Path(name)))
+        self.recent_menu.addSeparator()
+        clear = self.recent_menu.addAction("Clear Menu")
+        clear.triggered.connect(lambda: self.settings.setValue(RECENT_KEY, []))
+
+    def _update_title(self) -> None:
+        path = self.document.path
+        self.setWindowTitle(f"{path.name if path else 'untitled'}[*] — {APP_NAME}")
+        self.setWindowModified(self.document.modified)
+        self._update_status()
+
+    def _update_status(self) -> None:
+        document = self.document
+        labels = self.status_labels
+        if document.model is None:
+            labels["file"].setText("no structure")
+            return
+        structure = document.structure
+        labels["file"].setText(f"{document.path.name if document.path else ''}  ({structure.entry_id})")
+        labels["segment"].setText(f"chain {document.segment_label(document.segment)}")
+        labels["level"].setText(f"level {document.shown_level():.2f} / {document.max_level:.2f}")
+        pick = document.pick
+        labels["pick"].setText(
+            "Click a control point to pick it; drag it to edit. Drag elsewhere to turn the view." if pick is None
+            else f"point {pick.index} moves {len(pick.residues)} residues: {document.residue_range(pick.residues)}"
+        )
+
+    def _view_image(self) -> QImage:
+        """The 3D view rendered now, as an image."""
+        pixels = np.ascontiguousarray(self.plotter.screenshot(return_img=True))
+        height, width = pixels.shape[:2]
+        return QImage(pixels.data, width, height, 3 * width, QImage.Format.Format_RGB888).copy()
+
+
+def _scrolled(widget: QWidget) -> QScrollArea:
+    """``widget`` in a scroll area: a tall panel does not make the window taller."""
+    area = QScrollArea()
+    area.setWidget(widget)
+    area.setWidgetResizable(True)
+    return area
+
+
+@contextmanager
+def _busy() -> Iterator[None]:
+    """A wait cursor while the window works without returning to the event loop."""
+    QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)
+    try:
+        yield
+    finally:
+        QApplication.restoreOverrideCursor()

@@ -1,0 +1,146 @@
+"""What the atoms of a structure look like: colour schemes, bonds, ions and ligands (numpy/scipy).
+
+Bonds are found by distance (covalent radii plus a tolerance, as molecular viewers do),
+with a k-d tree; atoms of different alternate conformers are never bonded.
+"""
+
+from __future__ import annotations
+
+from enum import StrEnum
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from core.protein.structure import Structure
+
+RGB = tuple[int, int, int]
+
+
+class Colouring(StrEnum):
+    """Colour schemes of the ribbon tube."""
+
+    SECONDARY_STRUCTURE = "secondary structure"
+    RESIDUE_TYPE = "residue type"
+    CHAIN = "chain"
+
+
+SS_COLOURS: dict[str, RGB] = {"H": (222, 66, 91), "E": (246, 190, 0), "C": (176, 186, 198)}
+SS_NAMES = {"H": "helix", "E": "sheet", "C": "other"}
+
+RESIDUE_CLASSES: dict[str, tuple[RGB, tuple[str, ...]]] = {
+    "hydrophobic": ((214, 190, 140), ("ALA", "VAL", "LEU", "ILE", "MET", "PHE", "TRP", "CYS", "MSE")),
+    "polar": ((94, 186, 125), ("SER", "THR", "ASN", "GLN", "TYR")),
+    "acidic": ((225, 70, 60), ("ASP", "GLU")),
+    "basic": ((70, 120, 230), ("LYS", "ARG", "HIS")),
+    "glycine, proline": ((190, 190, 190), ("GLY", "PRO")),
+}
+OTHER_RESIDUE: RGB = (200, 120, 200)
+
+CHAIN_PALETTE: tuple[RGB, ...] = (
+    (76, 114, 176), (221, 132, 82), (85, 168, 104), (196, 78, 82), (129, 114, 179),
+    (147, 120, 96), (218, 139, 195), (140, 140, 140), (204, 185, 116), (100, 181, 205),
+)  # fmt: skip
+
+ELEMENT_COLOURS: dict[str, RGB] = {
+    "C": (160, 160, 160), "N": (48, 80, 248), "O": (255, 13, 13), "S": (255, 200, 50),
+    "P": (255, 128, 0), "H": (235, 235, 235), "SE": (255, 161, 0), "FE": (224, 102, 51),
+    "ZN": (125, 128, 176), "MG": (138, 255, 0), "CA": (61, 255, 0), "NA": (171, 92, 242),
+    "K": (143, 64, 212), "CL": (31, 240, 31), "MN": (156, 122, 199), "CU": (200, 128, 51),
+    "CO": (240, 144, 160), "NI": (80, 208, 80), "CD": (255, 217, 143), "F": (144, 224, 80),
+    "BR": (166, 41, 41), "I": (148, 0, 148),
+}  # fmt: skip
+OTHER_ELEMENT: RGB = (255, 20, 147)
+LIGAND_CARBON: RGB = (80, 200, 120)
+
+COVALENT_RADII: dict[str, float] = {
+    "H": 0.31, "C": 0.76, "N": 0.71, "O": 0.66, "S": 1.05, "P": 1.07, "SE": 1.20, "F": 0.57,
+    "CL": 1.02, "BR": 1.20, "I": 1.39, "B": 0.84, "SI": 1.11,
+}  # fmt: skip
+"""Å; elements not listed (metals) are not bonded: they are drawn as spheres."""
+BOND_TOLERANCE = 0.45
+"""Å added to the sum of the covalent radii."""
+
+
+def residue_colours(structure: Structure, colouring: Colouring | str) -> np.ndarray:
+    """Colour of every backbone residue (residue-table order), (n_residues, 3) uint8."""
+    colouring = Colouring(colouring)
+    segments = structure.segments
+    if colouring is Colouring.SECONDARY_STRUCTURE:
+        keys = np.concatenate([s.ss for s in segments])
+        table = SS_COLOURS
+        return np.array([table[k] for k in keys], dtype=np.uint8).reshape(-1, 3)
+    if colouring is Colouring.RESIDUE_TYPE:
+        by_name = {name: rgb for rgb, names in RESIDUE_CLASSES.values() for name in names}
+        names = np.concatenate([s.resname for s in segments])
+        return np.array([by_name.get(n, OTHER_RESIDUE) for n in names], dtype=np.uint8).reshape(-1, 3)
+    order = {name: k for k, name in enumerate(dict.fromkeys(s.chain for s in segments))}
+    colours = [CHAIN_PALETTE[order[s.chain] % len(CHAIN_PALETTE)] for s in segments for _ in range(len(s))]
+    return np.array(colours, dtype=np.uint8).reshape(-1, 3)
+
+
+def legend(structure: Structure, colouring: Colouring | str) -> list[tuple[str, RGB]]:
+    """Labels and colours of a scheme, for the entries present in ``structure``."""
+    colouring = Colouring(colouring)
+    if colouring is Colouring.SECONDARY_STRUCTURE:
+        return [(SS_NAMES[k], rgb) for k, rgb in SS_COLOURS.items()]
+    if colouring is Colouring.RESIDUE_TYPE:
+        return [(name, rgb) for name, (rgb, _) in RESIDUE_CLASSES.items()]
+    chains = dict.fromkeys(s.chain for s in structure.segments)
+    return [(f"chain {c}", CHAIN_PALETTE[k % len(CHAIN_PALETTE)]) for k, c in enumerate(chains)]
+
+
+def element_colours(elements: np.ndarray, carbon: RGB | None = None) -> np.ndarray:
+    """CPK-like colours (n, 3) uint8 of element symbols; ``carbon`` overrides the colour of C."""
+    table = dict(ELEMENT_COLOURS)
+    if carbon is not None:
+        table["C"] = carbon
+    return np.array([table.get(e.upper(), OTHER_ELEMENT) for e in elements], dtype=np.uint8).reshape(-1, 3)
+
+
+def ca_rows(structure: Structure) -> np.ndarray:
+    """Row of ``structure.coords`` holding the Cα of each backbone residue, (n_residues,)."""
+    ca = np.concatenate([s.ca for s in structure.segments])
+    owner = structure.atom_residue
+    candidates = np.flatnonzero(owner >= 0)
+    match = candidates[np.all(structure.coords[candidates] == ca[owner[candidates]], axis=1)]
+    residues, first = np.unique(owner[match], return_index=True)
+    if len(residues) != len(ca):
+        raise ValueError("every backbone residue must own the atom at its Cα position")
+    return match[first]
+
+
+def bonds(coords: np.ndarray, elements: np.ndarray, altloc: np.ndarray, atoms: np.ndarray) -> np.ndarray:
+    """Covalent bonds (b, 2) among the atom rows ``atoms``, by distance.
+
+    Parameters
+    ----------
+    coords : (n_atoms, 3) positions, Å.
+    elements, altloc : (n_atoms,) element symbols and alternate-location codes ('' if none).
+    atoms : rows to consider; elements without a covalent radius are skipped.
+    """
+    radius = np.array([COVALENT_RADII.get(e.upper(), np.nan) for e in elements[atoms]])
+    atoms = np.asarray(atoms)[np.isfinite(radius)]
+    radius = radius[np.isfinite(radius)]
+    if len(atoms) < 2:
+        return np.empty((0, 2), dtype=np.int64)
+    reach = 2 * max(COVALENT_RADII.values()) + BOND_TOLERANCE
+    pairs = cKDTree(coords[atoms]).query_pairs(reach, output_type="ndarray")
+    first, second = pairs[:, 0], pairs[:, 1]
+    distance = np.linalg.norm(coords[atoms[first]] - coords[atoms[second]], axis=1)
+    alt_first, alt_second = altloc[atoms[first]], altloc[atoms[second]]
+    keep = (
+        (distance <= radius[first] + radius[second] + BOND_TOLERANCE)
+        & (distance > 0.4)
+        & ((alt_first == "") | (alt_second == "") | (alt_first == alt_second))
+    )
+    return np.stack([atoms[first[keep]], atoms[second[keep]]], axis=1)
+
+
+def ions_and_ligands(structure: Structure) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of ion atoms (a non-polymer, non-water group of one heavy atom) and of other ligand atoms."""
+    table = structure.atoms
+    ligand = np.flatnonzero(table.category == "ligand")
+    heavy = ligand[np.char.upper(table.element[ligand].astype(str)) != "H"]
+    groups, counts = np.unique(table.residue[heavy], return_counts=True)
+    single = np.isin(table.residue[ligand], groups[counts == 1])
+    return ligand[single & (np.char.upper(table.element[ligand].astype(str)) != "H")], ligand[~single]

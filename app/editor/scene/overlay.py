@@ -1,0 +1,323 @@
+"""Structures shown for comparison: superposed on the edited chain, drawn at the same depth.
+
+Each compared structure is read once; one of its chains (the longest unless chosen) is
+paired with the document's current chain by :func:`core.analysis.compare.pair_residues` and
+superposed on the paired Cα with :func:`core.analysis.superpose.superpose`, refined on the pairs
+within :data:`CORE_CUTOFF` (a few loops that differ between homologues would pull a fit
+on all pairs). Its ribbons are built in the document's ribbon kind and moved by that
+motion (a B-spline curve moves with its control points).
+
+Levels: every chain has its own top level log2 N, so the compared chains are shown at the
+same *depth* below their top as the edited segment, ``log2 N_k - (log2 N - λ)``, and so
+with the same fraction of their detail. They are read-only.
+
+:class:`Comparison` (no widgets) holds them and says what changed; :class:`ComparisonView`
+draws each as a thin tube of its own colour and rewrites the tube vertices in place when
+the level changes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pyvista as pv
+from PySide6.QtCore import QObject, Signal
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+from app.editor.document import Document
+from app.editor.scene import tube
+from app.editor.scene.curves import LevelCurve, SegmentPath
+from core.analysis.compare import pair_residues
+from core.analysis.superpose import MIN_PAIRS, Superposition, fit_closest
+from core.protein.reading import read_structure
+from core.protein.ribbon import Ribbon, segment_ribbon
+from core.protein.structure import BackboneSegment, Structure
+
+CORE_CUTOFF = 3.0
+"""Å: the fit is refined on the paired Cα closer than this after fitting on themselves."""
+PALETTE: tuple[tuple[int, int, int], ...] = (
+    (31, 119, 180), (44, 160, 44), (148, 103, 189), (23, 190, 207), (140, 86, 75),
+    (227, 119, 194), (255, 127, 14), (188, 189, 34), (90, 90, 90),
+)  # fmt: skip
+"""Colours of the compared structures, in the order they are added (away from the
+secondary-structure red, yellow and grey of the edited structure's tube)."""
+TUBE_RADIUS = 0.35
+"""Å, the thin tubes of the compared structures."""
+TUBE_SIDES = 8
+
+
+@dataclass(frozen=True)
+class ChainFit:
+    """A superposition of a compared chain on the edited chain.
+
+    Attributes
+    ----------
+    motion : moves the compared chain onto the edited one.
+    n_pairs : paired residues (by numbering or structural alignment) with both Cα.
+    n_core : pairs the refined fit was computed on (closer than :data:`CORE_CUTOFF`).
+    rms_core, rms_all : rms Cα distance (Å) over those and over all pairs after the fit.
+    pairing : 'numbering' or 'structure' (see :func:`core.analysis.compare.pair_residues`).
+    """
+
+    motion: Superposition
+    n_pairs: int
+    n_core: int
+    rms_core: float
+    rms_all: float
+    pairing: str
+
+
+def chain_segments(structure: Structure, chain: str) -> list[BackboneSegment]:
+    """The backbone segments of ``chain``, in order (raises ValueError when it has none)."""
+    found = [s for s in structure.segments if s.chain == chain]
+    if not found:
+        raise ValueError(f"{structure.entry_id} has no protein chain {chain!r}; chains: {', '.join(chains(structure))}")
+    return found
+
+
+def chains(structure: Structure) -> list[str]:
+    """Chains with backbone segments, longest first (ties in file order)."""
+    length: dict[str, int] = {}
+    for segment in structure.segments:
+        length[segment.chain] = length.get(segment.chain, 0) + len(segment)
+    return sorted(length, key=lambda chain: -length[chain])
+
+
+def fit_chain(fixed_ca: np.ndarray, fixed: Sequence[BackboneSegment], moving: Sequence[BackboneSegment]) -> ChainFit:
+    """Superpose the chain ``moving`` on the chain ``fixed``, whose Cα are now at ``fixed_ca``.
+
+    Parameters
+    ----------
+    fixed_ca : (n_fixed_residues, 3) current Cα of ``fixed`` (edits included), Å.
+    fixed, moving : backbone segments of each chain, in order.
+
+    Raises
+    ------
+    ValueError
+        Fewer than 3 residue pairs.
+    """
+    pairs_a, pairs_b, pairing = pair_residues(fixed, moving)
+    a, b = fixed_ca[pairs_a], np.concatenate([s.ca for s in moving])[pairs_b]
+    usable = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
+    a, b = a[usable], b[usable]
+    if len(a) < MIN_PAIRS:
+        raise ValueError(f"only {len(a)} residue pair(s) with the edited chain; at least {MIN_PAIRS} are needed")
+    motion, core = fit_closest(a, b, CORE_CUTOFF)
+    distance = np.linalg.norm(a - motion.apply(b), axis=1)
+    return ChainFit(motion, len(a), int(core.sum()), _rms(distance[core]), _rms(distance), pairing)
+
+
+@dataclass(eq=False)
+class Compared:
+    """One compared structure: its chain, its superposition and its moved ribbons."""
+
+    path: Path
+    structure: Structure
+    chain: str
+    colour: tuple[int, int, int]
+    fit: ChainFit
+    fitted_to: str
+    """The edited structure's chain it was superposed on."""
+    ribbons: list[Ribbon]
+    paths: list[SegmentPath]
+    visible: bool = True
+    key: int = field(default=0)
+    """Unique among the compared structures of a :class:`Comparison` (names its actor)."""
+
+    @property
+    def name(self) -> str:
+        return f"{self.structure.entry_id} {self.chain}"
+
+
+class Comparison(QObject):
+    """The structures compared with a :class:`Document`'s current chain (a QObject without widgets).
+
+    Follows the document: a new structure, ribbon kind or chain refits every compared
+    structure (keeping the previous fit where the new chain cannot be paired).
+    """
+
+    changed = Signal()
+    """Structures were added or removed, or refitted: everything is new."""
+    visibilityChanged = Signal(int)
+    """The visibility of the structure at this index changed."""
+
+    def __init__(self, document: Document) -> None:
+        super().__init__(document)
+        self.document = document
+        self.items: list[Compared] = []
+        self._keys = 0
+        self._chain: str | None = None
+        document.loaded.connect(self._refit_all)
+        document.segmentChanged.connect(self._segment_changed)
+
+    @property
+    def depth(self) -> float:
+        """Levels below the top at which the edited segment, and so every compared chain, is shown."""
+        return self.document.max_level - self.document.shown_level()
+
+    def level(self, ribbon: Ribbon) -> float:
+        """The level at which a compared ``ribbon`` is shown: the same depth below its own log2 N."""
+        return float(np.clip(ribbon.max_level - self.depth, 0.0, ribbon.max_level))
+
+    def level_curves(self, index: int) -> list[LevelCurve]:
+        """The curves of every segment of compared structure ``index`` at its level."""
+        item = self.items[index]
+        return [path.level_curve(ribbon, self.level(ribbon)) for ribbon, path in zip(item.ribbons, item.paths)]
+
+    def add(self, path: Path, chain: str | None = None) -> Compared:
+        """Read ``path``, superpose ``chain`` (default: its longest) on the edited chain and show it.
+
+        Raises :class:`core.protein.structure.StructureError` (unreadable file) or ValueError (no such
+        chain, no protein, too few residue pairs, no structure open).
+        """
+        if self.document.model is None:
+            raise ValueError("open a structure before adding structures to compare with it")
+        structure = read_structure(path)
+        if not structure.segments:
+            raise ValueError(f"{Path(path).name}: no protein chain to compare")
+        colour = PALETTE[self._keys % len(PALETTE)]
+        self._chain = self.document.structure.segments[self.document.segment].chain
+        item = self._fitted(Path(path), structure, chain or chains(structure)[0], colour)
+        item.key = self._keys
+        self._keys += 1
+        self.items.append(item)
+        self.changed.emit()
+        return item
+
+    def set_chain(self, index: int, chain: str) -> None:
+        """Compare chain ``chain`` of structure ``index`` instead (raises ValueError as :meth:`add`)."""
+        item = self.items[index]
+        if chain != item.chain:
+            fitted = self._fitted(item.path, item.structure, chain, item.colour)
+            fitted.key, fitted.visible = item.key, item.visible
+            self.items[index] = fitted
+            self.changed.emit()
+
+    def set_visible(self, index: int, visible: bool) -> None:
+        if self.items[index].visible != visible:
+            self.items[index].visible = visible
+            self.visibilityChanged.emit(index)
+
+    def remove(self, index: int) -> None:
+        del self.items[index]
+        self.changed.emit()
+
+    # ------------------------------------------------------------------ internals
+
+    def _fitted(self, path: Path, structure: Structure, chain: str, colour: tuple[int, int, int],
+                previous: ChainFit | None = None, previous_to: str = "") -> Compared:
+        document = self.document
+        segments = chain_segments(structure, chain)
+        edited = document.structure.segments[document.segment].chain
+        try:
+            fit, fitted_to = fit_chain(*self._edited_chain(), segments), edited
+        except ValueError:
+            if previous is None:
+                raise
+            fit, fitted_to = previous, previous_to
+        ribbons = [segment_ribbon(s, document.kind) for s in segments]
+        moved = [r.with_points(fit.motion.apply(r.points)) for r in ribbons]
+        return Compared(path, structure, chain, colour, fit, fitted_to, moved, [SegmentPath(r) for r in moved])
+
+    def _edited_chain(self) -> tuple[np.ndarray, list[BackboneSegment]]:
+        document = self.document
+        segments = chain_segments(document.structure, document.structure.segments[document.segment].chain)
+        rows = np.concatenate([s.residue_index for s in segments])
+        return document.model.coords[document.ca_rows[rows]], segments
+
+    def _refit_all(self) -> None:
+        self._chain = self.document.structure.segments[self.document.segment].chain
+        refitted = []
+        for item in self.items:
+            fitted = self._fitted(item.path, item.structure, item.chain, item.colour, item.fit, item.fitted_to)
+            fitted.key, fitted.visible = item.key, item.visible
+            refitted.append(fitted)
+        self.items = refitted
+        self.changed.emit()
+
+    def _segment_changed(self) -> None:
+        if self.document.structure.segments[self.document.segment].chain != self._chain:
+            self._refit_all()
+
+
+class ComparisonView(QObject):
+    """Draws the compared structures of a :class:`Comparison` as thin tubes into a plotter."""
+
+    def __init__(self, comparison: Comparison, plotter: pv.BasePlotter) -> None:
+        super().__init__(comparison)
+        self.comparison = comparison
+        self.plotter = plotter
+        self.meshes: dict[int, pv.PolyData] = {}
+        """Tube mesh of each compared structure, by its key."""
+        self.actors: dict[int, pv.Actor] = {}
+        comparison.changed.connect(self._rebuild)
+        comparison.visibilityChanged.connect(self._show)
+        comparison.document.levelChanged.connect(self._update)  # a new segment changes the level too
+
+    def actor_name(self, item: Compared) -> str:
+        """Name of the plotter actor of ``item``'s tube."""
+        return f"compared_{item.key}"
+
+    def _rebuild(self) -> None:
+        for key in list(self.actors):
+            self.plotter.remove_actor(self.actors.pop(key), render=False)
+        self.meshes.clear()
+        for index, item in enumerate(self.comparison.items):
+            rings = [len(path.curve_u) for path in item.paths]
+            start = np.cumsum([0] + rings) * TUBE_SIDES
+            faces = np.vstack([tube.tube_faces(n, TUBE_SIDES, first) for n, first in zip(rings, start)])
+            mesh = pv.PolyData(np.zeros((start[-1], 3)), faces=np.column_stack([np.full(len(faces), 4), faces]).ravel())
+            mesh.point_data["Normals"] = np.zeros((start[-1], 3))
+            mesh.point_data.active_normals_name = "Normals"
+            self.meshes[item.key] = mesh
+            self._sweep(index)
+            self.actors[item.key] = self.plotter.add_mesh(
+                mesh, name=self.actor_name(item), color=item.colour, reset_camera=False, pickable=False,
+                smooth_shading=False, render=False, interpolation="phong", specular=0.3, specular_power=20.0,
+            )
+            self.actors[item.key].SetVisibility(item.visible)
+        self.plotter.render()
+
+    def _update(self) -> None:
+        for index in range(len(self.comparison.items)):
+            self._sweep(index)
+        self.plotter.render()
+
+    def _show(self, index: int) -> None:
+        item = self.comparison.items[index]
+        self.actors[item.key].SetVisibility(item.visible)
+        self.plotter.render()
+
+    def _sweep(self, index: int) -> None:
+        """Rewrite the tube of compared structure ``index`` around its curves at the current level."""
+        curves = self.comparison.level_curves(index)
+        points, normals = [], []
+        for curve in curves:
+            tangents = _tangents(curve.samples)
+            ring_points, radial = tube.ring_vertices(curve.samples, tangents, tube.transported_normals(tangents),
+                                                     np.full(len(tangents), TUBE_RADIUS), TUBE_SIDES)
+            points.append(ring_points)
+            normals.append(radial)
+        mesh = self.meshes[self.comparison.items[index].key]
+        arrays = (mesh.GetPoints().GetData(), mesh.GetPointData().GetArray("Normals"))
+        for target, values in zip(arrays, (points, normals)):
+            vtk_to_numpy(target)[:] = np.vstack(values)
+            target.Modified()
+        mesh.Modified()
+
+
+def _rms(distances: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(distances**2)))
+
+
+def _tangents(samples: np.ndarray) -> np.ndarray:
+    """Unit tangents (n, 3) of a sampled curve (n, 3) by central differences; where samples
+    coincide (the clipped ends of a ribbon) the nearest defined tangent is used."""
+    step = np.gradient(samples, axis=0)
+    length = np.linalg.norm(step, axis=1)
+    defined = np.flatnonzero(length > 1e-9 * max(float(length.max(initial=0.0)), 1.0))
+    nearest = defined[np.clip(np.searchsorted(defined, np.arange(len(samples))), 0, len(defined) - 1)]
+    return step[nearest] / length[nearest, None]

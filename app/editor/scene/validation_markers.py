@@ -1,0 +1,89 @@
+"""Markers on the model at the bad peptide junctions and the clashes, coloured by severity.
+
+One actor of its own (``validation_markers``, the scene's :attr:`~app.editor.scene.scene.Layer.VALIDATION`
+layer): a point set drawn as spheres, one point per junction or clash flag of the live
+report, rewritten in place when the report changes. Ramachandran outliers are listed in the
+validation panel but not marked (a residue, not a place between atoms).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+from PySide6.QtCore import QObject
+from vtkmodules.util.numpy_support import vtk_to_numpy
+
+from app.editor.live_validation import LiveValidation
+from app.editor.scene.scene import Layer, Scene
+from core.geometry.validation import Flag
+
+NAME = "validation_markers"
+MARKED = ("peptide_bond", "ca_ca", "angle_ca_c_n", "angle_c_n_ca", "omega", "clash")
+"""Flag kinds that get a marker."""
+MARKER_PIXELS = 14.0
+"""Marker diameter on screen, pixels."""
+MILD, SEVERE = np.array([250, 205, 40]), np.array([215, 25, 28])
+"""Colours of a flag just over its tolerance (severity 1) and of one at :data:`SEVERE_AT` or more."""
+SEVERE_AT = 4.0
+
+
+def severity_colours(severity: np.ndarray) -> np.ndarray:
+    """(n, 3) uint8 colours from yellow (severity 1) to red (severity >= :data:`SEVERE_AT`)."""
+    t = np.clip((np.asarray(severity, dtype=float) - 1.0) / (SEVERE_AT - 1.0), 0.0, 1.0)[:, None]
+    return np.rint((1.0 - t) * MILD + t * SEVERE).astype(np.uint8)
+
+
+def marked(flags: tuple[Flag, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """Positions (n, 3), Å, and severities (n,) of the flags that get a marker."""
+    chosen = [f for f in flags if f.kind in MARKED]
+    positions = np.array([f.position for f in chosen], dtype=float).reshape(-1, 3)
+    return positions, np.array([f.severity for f in chosen], dtype=float)
+
+
+class ValidationMarkers(QObject):
+    """Draws the live report's junction and clash flags into the scene's plotter."""
+
+    def __init__(self, validation: LiveValidation, scene: Scene) -> None:
+        super().__init__(scene)
+        self.validation = validation
+        self.scene = scene
+        self.mesh = pv.PolyData()
+        validation.updated.connect(self.refresh)
+        scene.document.loaded.connect(self.refresh)  # after the scene's rebuild, which removes every actor
+        self.refresh()
+
+    def refresh(self) -> None:
+        """Show the markers of the current report; render only after a deferred check (the
+        scene renders after each change)."""
+        report = self.validation.report
+        if report is None:
+            return
+        if NAME not in self.scene.plotter.actors:
+            self.mesh.shallow_copy(_points(np.zeros((1, 3)), np.zeros((1, 3), dtype=np.uint8)))  # not empty
+            self.scene.actors[NAME] = self.scene.plotter.add_mesh(
+                self.mesh, name=NAME, scalars="colours", rgb=True, render_points_as_spheres=True,
+                point_size=MARKER_PIXELS, reset_camera=False, pickable=False, show_scalar_bar=False, render=False,
+            )
+        positions, severity = marked(report.flags)
+        colours = severity_colours(severity)
+        if len(positions) and len(positions) == self.mesh.n_points:
+            for target, values in ((self.mesh.GetPoints().GetData(), positions),
+                                   (self.mesh.GetPointData().GetArray("colours"), colours)):
+                vtk_to_numpy(target)[:] = values
+                target.Modified()
+            self.mesh.Modified()
+        else:
+            self.mesh.shallow_copy(_points(positions, colours))
+        visible = Layer.VALIDATION in self.scene.layers
+        self.scene.actors[NAME].SetVisibility(visible)
+        if visible and self.validation.late:
+            self.scene.plotter.render()
+
+
+def _points(positions: np.ndarray, colours: np.ndarray) -> pv.PolyData:
+    """One vertex per position, coloured; an empty mesh (no colours array) for none."""
+    if len(positions) == 0:
+        return pv.PolyData()
+    mesh = pv.PolyData(positions.copy())
+    mesh.point_data["colours"] = colours
+    return mesh

@@ -1,0 +1,143 @@
+"""A protein being edited: atom coordinates plus one multiresolution ribbon per backbone segment.
+
+:class:`EditableModel` turns multiresolution edits of a ribbon (a control point moved at a
+slider level, or a curve point tugged) into rigid-body motions of the affected residues.
+Every change is an :class:`Edit` that holds exactly what it changed, so it can be undone
+and redone bit for bit. Atoms of residues the edit does not reach are never rewritten.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from core.curves.editing import changed_segments, move_control_point, tug_curve
+from core.protein.frames import remap_atoms, residue_frames
+from core.protein.ribbon import Ribbon, RibbonKind, segment_ribbon
+from core.protein.structure import BackboneSegment, Structure
+from core.protein.writing import write_structure
+
+NEGLIGIBLE_MOVE = 1e-6
+"""Control-point changes up to this size (Å) move no residue: fractional-level edits have
+exponentially decaying tails over the whole segment that would otherwise remap it all."""
+
+
+@dataclass(frozen=True, eq=False)
+class Edit:
+    """One change of one segment: its ribbon control points and the atoms that moved.
+
+    Attributes
+    ----------
+    segment : index into ``EditableModel.segments``.
+    old_points, new_points : (2**J + 3, 3) finest control points before and after.
+    residues : indices (within the segment) of the residues that moved.
+    rows : rows of the coordinate array that moved (all atoms of those residues).
+    old_coords, new_coords : (len(rows), 3) their coordinates before and after.
+    """
+
+    segment: int
+    old_points: np.ndarray
+    new_points: np.ndarray
+    residues: np.ndarray
+    rows: np.ndarray
+    old_coords: np.ndarray
+    new_coords: np.ndarray
+
+    def then(self, later: Edit) -> Edit:
+        """The single edit equivalent to this one followed by ``later`` (same segment)."""
+        if later.segment != self.segment:
+            raise ValueError(f"cannot merge edits of segments {self.segment} and {later.segment}")
+        rows = np.union1d(self.rows, later.rows)
+        old = np.empty((len(rows), 3))
+        new = np.empty((len(rows), 3))
+        old[np.searchsorted(rows, later.rows)] = later.old_coords  # rows first moved by `later`
+        old[np.searchsorted(rows, self.rows)] = self.old_coords
+        new[np.searchsorted(rows, self.rows)] = self.new_coords
+        new[np.searchsorted(rows, later.rows)] = later.new_coords
+        residues = np.union1d(self.residues, later.residues)
+        return Edit(self.segment, self.old_points, later.new_points, residues, rows, old, new)
+
+
+class EditableModel:
+    """Coordinates and ribbons of a structure under multiresolution editing.
+
+    Parameters
+    ----------
+    structure : the structure read from a file (never modified).
+    kind : 'peptide' (peptide-plane ribbon, the default) or 'calpha'.
+    helix_offset : shift of helix guide points off the axis, Å (peptide ribbon only).
+    """
+
+    def __init__(self, structure: Structure, kind: RibbonKind | str = RibbonKind.PEPTIDE, helix_offset: float = 0.0):
+        self.structure = structure
+        self.kind = RibbonKind(kind)
+        self.coords = np.array(structure.coords)
+        self.ribbons = [segment_ribbon(s, self.kind, helix_offset) for s in structure.segments]
+
+    @property
+    def segments(self) -> tuple[BackboneSegment, ...]:
+        """The backbone segments, in the order of :attr:`ribbons`."""
+        return self.structure.segments
+
+    def move_point(self, segment: int, level: float, index: int, displacement: object) -> Edit:
+        """Move control point ``index`` of the curve shown at slider ``level`` (planned, not applied)."""
+        ribbon = self._ribbon(segment)
+        delta = move_control_point(ribbon.fs_level(level), index, displacement, ribbon.level)
+        return self.plan(segment, ribbon.points + delta)
+
+    def tug(self, segment: int, level: float, u: float, displacement: object) -> Edit:
+        """Drag the point at parameter ``u`` of the curve shown at slider ``level`` (planned)."""
+        ribbon = self._ribbon(segment)
+        delta = tug_curve(ribbon.fs_level(level), u, displacement, ribbon.level)
+        return self.plan(segment, ribbon.points + delta)
+
+    def plan(self, segment: int, new_points: np.ndarray) -> Edit:
+        """The edit that gives segment ``segment`` the finest control points ``new_points``."""
+        ribbon = self._ribbon(segment)
+        new_ribbon = ribbon.with_points(new_points)
+        moved_segments = changed_segments(new_ribbon.points - ribbon.points, tolerance=NEGLIGIBLE_MOVE)
+        residues = ribbon.residue_segments(moved_segments)
+        rows, owner = _residue_rows(self.segments[segment], residues)
+        u = ribbon.residue_u[residues]
+        old_frames = residue_frames(ribbon.space, ribbon.points, u)
+        new_frames = residue_frames(ribbon.space, new_ribbon.points, u, reference=old_frames)
+        old_coords = self.coords[rows]
+        new_coords = remap_atoms(
+            old_coords,
+            owner,
+            ribbon.space.evaluate(ribbon.points, u),
+            old_frames,
+            ribbon.space.evaluate(new_ribbon.points, u),
+            new_frames,
+        )
+        return Edit(segment, ribbon.points, new_ribbon.points, residues, rows, old_coords, new_coords)
+
+    def apply(self, edit: Edit) -> None:
+        """Carry out ``edit`` (redo)."""
+        self.coords[edit.rows] = edit.new_coords
+        self.ribbons[edit.segment] = self.ribbons[edit.segment].with_points(edit.new_points)
+
+    def revert(self, edit: Edit) -> None:
+        """Undo ``edit`` exactly."""
+        self.coords[edit.rows] = edit.old_coords
+        self.ribbons[edit.segment] = self.ribbons[edit.segment].with_points(edit.old_points)
+
+    def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
+        """Write the current coordinates (PDB or mmCIF by the extension), atomically."""
+        return write_structure(self.structure, self.coords, path, overwrite=overwrite)
+
+    def _ribbon(self, segment: int) -> Ribbon:
+        if not 0 <= segment < len(self.ribbons):
+            raise ValueError(f"segment must be in [0, {len(self.ribbons) - 1}]; got {segment}")
+        return self.ribbons[segment]
+
+
+def _residue_rows(segment: BackboneSegment, residues: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Coordinate rows of all atoms of ``residues`` and, per row, its position in ``residues``."""
+    starts, stops = segment.atom_start[residues], segment.atom_stop[residues]
+    lengths = stops - starts
+    owner = np.repeat(np.arange(len(residues)), lengths)
+    offsets = np.arange(lengths.sum()) - np.repeat(np.cumsum(lengths) - lengths, lengths)
+    return starts[owner] + offsets, owner

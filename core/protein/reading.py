@@ -1,0 +1,288 @@
+"""Reading PDB and mmCIF files (optionally gzipped) with gemmi into a :class:`Structure`.
+
+:func:`read_structure` returns the first model's atoms plus the protein backbone cut into
+continuous segments (:mod:`core.protein.segments`); :func:`read_atoms` returns just the
+:class:`AtomTable` of any entry (DNA without protein included), for surfaces and maps.
+The format is taken from the content, not the name. The gemmi objects stay private
+inside ``Structure``.
+"""
+
+from __future__ import annotations
+
+import gzip
+import os
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import gemmi
+import numpy as np
+
+from core.protein.segments import (
+    atom_residue,
+    backbone_runs,
+    chain_summaries,
+    make_segments,
+    residue_groups,
+    secondary_structure,
+)  # fmt: skip
+from core.protein.structure import AtomTable, Structure, StructureError, frozen
+
+_BACKBONE = ("N", "CA", "C", "O")
+_PEPTIDE = (gemmi.PolymerType.PeptideL, gemmi.PolymerType.PeptideD)
+
+
+def read_structure(path: str | os.PathLike[str]) -> Structure:
+    """Read a PDB or mmCIF file (optionally gzipped); the format is taken from the content.
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    Structure
+
+    Raises
+    ------
+    StructureError
+        Missing, empty or unreadable file, no atoms, no protein chain, or non-finite
+        coordinates; the message names the file.
+    """
+    path = Path(path)
+    text, fmt, st, atoms = _read_model(path)
+    notes: list[str] = []
+    groups = residue_groups(atoms)
+    runs = backbone_runs(atoms, groups, notes)
+    if not runs:
+        raise StructureError(
+            f"{path}: no protein chain (no two consecutive amino-acid residues with Cα)"
+        )
+    rows = np.concatenate(runs)
+    ss, ss_source = secondary_structure(st, fmt, atoms, groups, runs, notes)
+    segments = make_segments(atoms, groups, runs, ss)
+    return Structure(
+        path=path,
+        source_format=fmt,
+        entry_id=st.name,
+        title=_info(st, "_struct.title"),
+        coords=frozen(atoms.coords),
+        atom_residue=frozen(atom_residue(len(atoms.coords), groups, rows)),
+        segments=segments,
+        ss_source=ss_source,
+        chains=chain_summaries(atoms, segments),
+        n_models=len(st),
+        n_hetero_atoms=atoms.n_hetero,
+        n_water_atoms=atoms.n_water,
+        n_altloc_atoms=atoms.n_altloc,
+        warnings=tuple(notes),
+        atoms=_atom_table(st.name, atoms),
+        _template=st,
+        _text=text,
+    )
+
+
+def read_atoms(path: str | os.PathLike[str]) -> AtomTable:
+    """Read every atom of the first model of a PDB or mmCIF file (optionally gzipped).
+
+    Unlike :func:`read_structure` this needs no protein chain (e.g. a DNA duplex).
+
+    Raises
+    ------
+    StructureError
+        Missing, empty or unreadable file, no atoms, or non-finite coordinates.
+    """
+    path = Path(path)
+    _, _, st, atoms = _read_model(path)
+    return _atom_table(st.name, atoms)
+
+
+def _read_model(path: Path) -> tuple[str, str, gemmi.Structure, ScannedModel]:
+    """Text, format, parsed structure and scanned first model of a file with finite atoms."""
+    text = _read_text(path)
+    fmt = "mmcif" if _looks_like_mmcif(text) else "pdb"
+    st = _parse(text, fmt, path)
+    atoms = scan_model(st[0])
+    if len(atoms.coords) == 0:
+        raise StructureError(f"{path}: not a structure file (no atoms found)")
+    if not np.isfinite(atoms.coords).all():
+        bad = int((~np.isfinite(atoms.coords).all(axis=1)).sum())
+        raise StructureError(f"{path}: {bad} atom(s) have non-finite coordinates")
+    return text, fmt, st, atoms
+
+
+def _atom_table(entry_id: str, atoms: ScannedModel) -> AtomTable:
+    counts = atoms.stop - atoms.start
+
+    def per_atom(values: object, dtype: type) -> np.ndarray:
+        return frozen(np.repeat(np.asarray(values, dtype=dtype), counts))
+
+    category = np.select(
+        [atoms.water, atoms.protein, atoms.nucleic], ["water", "protein", "nucleic"], "ligand"
+    )
+    return AtomTable(
+        entry_id=entry_id,
+        coords=frozen(atoms.coords),
+        name=frozen(np.array(atoms.atom_name, dtype=str).reshape(-1)),
+        element=frozen(np.array(atoms.element, dtype=str).reshape(-1)),
+        altloc=frozen(np.array(atoms.altloc, dtype="<U1").reshape(-1)),
+        resname=per_atom(atoms.resname, str),
+        chain=per_atom(atoms.chain, str),
+        resseq=per_atom(atoms.seq, np.int64),
+        residue=per_atom(np.arange(len(counts)), np.int64),
+        b_factor=frozen(np.array(atoms.b_factor, dtype=np.float64)),
+        occupancy=frozen(np.array(atoms.occupancy, dtype=np.float64)),
+        category=per_atom(category, str),
+    )
+
+
+def _read_text(path: Path) -> str:
+    """File content as text, gunzipped when it starts with the gzip magic bytes."""
+    if not path.exists():
+        raise StructureError(f"{path}: no such file")
+    if path.is_dir():
+        raise StructureError(f"{path}: is a directory, not a structure file")
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise StructureError(f"{path}: cannot read ({exc.strerror})") from None
+    if data[:2] == b"\x1f\x8b":
+        try:
+            data = gzip.decompress(data)
+        except (OSError, EOFError, zlib.error) as exc:
+            raise StructureError(f"{path}: corrupt gzip file ({exc})") from None
+    if not data.strip():
+        raise StructureError(f"{path}: empty file")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+
+
+def _looks_like_mmcif(text: str) -> bool:
+    """True when the first line that is neither blank nor a comment starts a CIF block."""
+    for line in text.splitlines():
+        stripped = line.strip()
+        if stripped and not stripped.startswith("#"):
+            return stripped.lower().startswith("data_")
+    return False
+
+
+def _parse(text: str, fmt: str, path: Path) -> gemmi.Structure:
+    """gemmi.Structure of ``text`` with entities set up and ``name`` set to the entry id."""
+    try:
+        if fmt == "mmcif":
+            st = gemmi.make_structure_from_block(gemmi.cif.read_string(text)[0])
+        else:
+            st = gemmi.read_pdb_string(text)
+    except (RuntimeError, ValueError, IndexError) as exc:
+        kind = "mmCIF" if fmt == "mmcif" else "PDB"
+        raise StructureError(f"{path}: not a readable {kind} file ({exc})") from None
+    if len(st) == 0:
+        raise StructureError(f"{path}: not a structure file (no atoms found)")
+    st.setup_entities()
+    st.name = _info(st, "_entry.id") or path.name.split(".")[0]
+    return st
+
+
+def _info(st: gemmi.Structure, key: str) -> str:
+    return st.info[key] if key in st.info else ""
+
+
+@dataclass
+class ScannedModel:
+    """Flat arrays from one pass over a gemmi model; one entry per gemmi residue."""
+
+    coords: np.ndarray  # (n_atoms, 3)
+    chain: list[str]
+    chain_part: np.ndarray  # ordinal of the gemmi chain (a chain id may have several parts)
+    seq: np.ndarray
+    icode: list[str]
+    resname: list[str]
+    protein: np.ndarray  # bool
+    start: np.ndarray
+    stop: np.ndarray
+    backbone: np.ndarray  # (n_res, 4) rows of coords for N, CA, C, O, -1 if missing
+    nucleic: np.ndarray  # bool, polymer nucleotide
+    water: np.ndarray  # bool
+    atom_name: list[str]  # per atom from here on
+    element: list[str]
+    altloc: list[str]
+    b_factor: list[float]
+    occupancy: list[float]
+    n_hetero: int
+    n_water: int
+    n_altloc: int
+
+
+def scan_model(model: gemmi.Model) -> ScannedModel:
+    """Walk the model once (chain, residue, atom) and collect everything needed."""
+    xyz: list[tuple[float, float, float]] = []
+    chain, part, seq, icode, resname, protein, start, stop, backbone = ([] for _ in range(9))
+    nucleic, water, atom_name, element, altloc, b_factor, occupancy = ([] for _ in range(7))
+    n_hetero = n_water = n_altloc = 0
+    amino_acid: dict[str, bool] = {}
+    nucleotide: dict[str, bool] = {}
+    for k, ch in enumerate(model):
+        peptide_chain = ch.get_polymer().check_polymer_type() in _PEPTIDE
+        for res in ch:
+            first = len(xyz)
+            bb = [-1, -1, -1, -1]
+            conformer = ""
+            for atom in res:
+                p = atom.pos
+                xyz.append((p.x, p.y, p.z))
+                alt = atom.altloc if atom.has_altloc() else ""
+                atom_name.append(atom.name)
+                element.append(atom.element.name)
+                altloc.append(alt)
+                b_factor.append(atom.b_iso)
+                occupancy.append(atom.occ)
+                n_altloc += alt != ""
+                conformer = conformer or alt
+                if atom.name in _BACKBONE and alt in ("", conformer):
+                    slot = _BACKBONE.index(atom.name)
+                    if bb[slot] < 0:
+                        bb[slot] = len(xyz) - 1
+            if res.is_water():
+                n_water += len(res)
+            elif res.het_flag == "H":
+                n_hetero += len(res)
+            if res.name not in amino_acid:
+                tabulated = gemmi.find_tabulated_residue(res.name)
+                amino_acid[res.name] = tabulated.is_amino_acid()
+                nucleotide[res.name] = tabulated.is_nucleic_acid()
+            polymer = res.entity_type == gemmi.EntityType.Polymer
+            nucleic.append(polymer and nucleotide[res.name])
+            water.append(res.is_water())
+            chain.append(ch.name)
+            part.append(k)
+            seq.append(res.seqid.num)
+            icode.append(res.seqid.icode.strip())
+            resname.append(res.name)
+            protein.append(polymer and (peptide_chain or amino_acid[res.name]))
+            start.append(first)
+            stop.append(len(xyz))
+            backbone.append(bb)
+    return ScannedModel(
+        coords=np.array(xyz, dtype=np.float64).reshape(-1, 3),
+        chain=chain,
+        chain_part=np.array(part, dtype=np.int64),
+        seq=np.array(seq, dtype=np.int64),
+        icode=icode,
+        resname=resname,
+        protein=np.array(protein, dtype=bool),
+        start=np.array(start, dtype=np.int64),
+        stop=np.array(stop, dtype=np.int64),
+        backbone=np.array(backbone, dtype=np.int64).reshape(-1, 4),
+        nucleic=np.array(nucleic, dtype=bool),
+        water=np.array(water, dtype=bool),
+        atom_name=atom_name,
+        element=element,
+        altloc=altloc,
+        b_factor=b_factor,
+        occupancy=occupancy,
+        n_hetero=n_hetero,
+        n_water=n_water,
+        n_altloc=n_altloc,
+    )

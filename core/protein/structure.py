@@ -1,0 +1,224 @@
+"""Protein structures as numpy arrays: the frozen :class:`Structure`, its
+:class:`BackboneSegment` s and :class:`AtomTable`; read by :mod:`core.protein.reading`,
+written back by :mod:`core.protein.writing` (the only modules that touch gemmi, with
+:mod:`core.protein.segments`).
+
+Conventions
+-----------
+- Lengths in Å; coordinate arrays are float64 ``(n, 3)`` and read-only.
+- ``Structure.coords`` lists every atom of the first model in gemmi's traversal order
+  (chain, residue, atom, i.e. file order): all alternate locations, hydrogens, hetero
+  groups, waters, nucleic acids.
+- Backbone residues are numbered 0 .. n_residues-1 over all segments in order (the
+  *residue table*); ``Structure.atom_residue`` maps each atom to that number or -1.
+- The backbone arrays use the first conformer (the first altloc met in the residue; the
+  first residue of a group sharing one sequence number), but a residue's atom range
+  covers all of its atoms and alternate conformers, so they move together.
+- A protein chain is cut into segments where consecutive Cα atoms are more than
+  :data:`MAX_CA_STEP` apart; residues without Cα are skipped and one-residue segments are
+  dropped, each with a message in ``Structure.warnings`` (their atoms keep
+  ``atom_residue == -1``). Every segment therefore has at least two residues.
+- Secondary structure: from the file's HELIX/SHEET records (mmCIF struct_conf /
+  struct_sheet_range) when it has any, otherwise computed by
+  :func:`core.protein.secondary_structure.dssp`: 'H' any helix (records of every helix class;
+  DSSP α, 3₁₀ and π helices, one residue longer at each end like the wwPDB annotation),
+  'E' sheet strand (DSSP ladder), 'C' otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+import gemmi
+import numpy as np
+from numpy.typing import NDArray
+
+MAX_CA_STEP = 4.2
+"""Largest Cα–Cα distance (Å) between consecutive residues of one segment."""
+
+SS_FROM_PDB_RECORDS = "HELIX/SHEET records"
+SS_FROM_MMCIF = "mmCIF struct_conf/struct_sheet_range"
+SS_COMPUTED = "computed (DSSP, core.protein.secondary_structure)"
+
+
+class StructureError(ValueError):
+    """A file that cannot be used as a protein structure, or a bad argument to a writer."""
+
+
+@dataclass(frozen=True, eq=False)
+class BackboneSegment:
+    """A continuous stretch of one protein chain (no Cα–Cα step above MAX_CA_STEP).
+
+    Attributes
+    ----------
+    chain : str
+        Author chain id (may have several characters, may be empty).
+    resseq : (N,) int64
+        Author residue numbers.
+    icode : (N,) str
+        Insertion codes, '' where none.
+    resname : (N,) str
+        Residue names.
+    ss : (N,) str
+        Secondary structure per residue: 'H', 'E' or 'C'.
+    n, ca, c, o : (N, 3) float64, Å
+        Backbone atoms (first conformer); ``ca`` is always finite, the others are NaN
+        where the atom is missing (all NaN for Cα-only models).
+    residue_index : (N,) int64
+        Rows of the structure's residue table (consecutive numbers).
+    atom_start, atom_stop : (N,) int64
+        Residue i owns rows ``atom_start[i]:atom_stop[i]`` of ``Structure.coords``: all
+        its atoms, alternate locations and hydrogens included.
+    """
+
+    chain: str
+    resseq: NDArray[np.int64]
+    icode: NDArray[np.str_]
+    resname: NDArray[np.str_]
+    ss: NDArray[np.str_]
+    n: NDArray[np.float64]
+    ca: NDArray[np.float64]
+    c: NDArray[np.float64]
+    o: NDArray[np.float64]
+    residue_index: NDArray[np.int64]
+    atom_start: NDArray[np.int64]
+    atom_stop: NDArray[np.int64]
+
+    def __len__(self) -> int:
+        return len(self.resseq)
+
+    def atoms(self, i: int) -> slice:
+        """Rows of ``Structure.coords`` holding the atoms of residue ``i``."""
+        return slice(int(self.atom_start[i]), int(self.atom_stop[i]))
+
+    @cached_property
+    def labels(self) -> tuple[str, ...]:
+        """Residue labels such as ``'A:LYS48'`` or ``'A:SER52A'``."""
+        return tuple(
+            f"{self.chain}:{name}{num}{ic}"
+            for name, num, ic in zip(self.resname, self.resseq.tolist(), self.icode, strict=True)
+        )
+
+
+@dataclass(frozen=True)
+class ChainSummary:
+    """Residue counts of one chain id in the first model."""
+
+    name: str
+    n_residues: int
+    """All residues with this chain id: polymer, ligands, water."""
+    n_backbone: int
+    """Residues in backbone segments."""
+    n_segments: int
+
+
+ATOM_CATEGORIES = ("protein", "nucleic", "ligand", "water")
+"""Values of ``AtomTable.category``: polymer amino acids, polymer nucleotides, every other
+non-water group (ligands, ions, non-polymer hetero groups), and waters."""
+
+
+@dataclass(frozen=True, eq=False)
+class AtomTable:
+    """Every atom of the first model, in the order of ``Structure.coords``; read-only arrays.
+
+    Attributes
+    ----------
+    entry_id : str
+    coords : (n_atoms, 3) float64, Å
+    name, element, altloc : (n_atoms,) str
+        Atom name, element symbol ('C', 'Fe', ...) and alternate location ('' where none).
+    resname, chain : (n_atoms,) str
+    resseq : (n_atoms,) int64
+        Author residue numbers.
+    residue : (n_atoms,) int64
+        Ordinal of the atom's residue in the model (file order, from 0).
+    b_factor : (n_atoms,) float64, Å²
+    occupancy : (n_atoms,) float64
+    category : (n_atoms,) str
+        One of :data:`ATOM_CATEGORIES`.
+    """
+
+    entry_id: str
+    coords: NDArray[np.float64]
+    name: NDArray[np.str_]
+    element: NDArray[np.str_]
+    altloc: NDArray[np.str_]
+    resname: NDArray[np.str_]
+    chain: NDArray[np.str_]
+    resseq: NDArray[np.int64]
+    residue: NDArray[np.int64]
+    b_factor: NDArray[np.float64]
+    occupancy: NDArray[np.float64]
+    category: NDArray[np.str_]
+
+    def __len__(self) -> int:
+        return len(self.coords)
+
+
+@dataclass(frozen=True, eq=False)
+class Structure:
+    """The first model of a PDB/mmCIF entry as arrays; see the module docstring.
+
+    Attributes
+    ----------
+    path : Path
+        The file read.
+    source_format : str
+        'pdb' or 'mmcif'.
+    entry_id, title : str
+        PDB id (or the file name) and title ('' if none).
+    coords : (n_atoms, 3) float64, Å
+        Every atom of the first model in traversal order.
+    atom_residue : (n_atoms,) int64
+        Residue-table row of each atom, -1 for atoms outside the backbone segments.
+    segments : tuple of BackboneSegment
+    ss_source : str
+        One of SS_FROM_PDB_RECORDS, SS_FROM_MMCIF, SS_COMPUTED.
+    chains : tuple of ChainSummary
+        In order of first appearance.
+    n_models : int
+        Models in the file (only the first is read and edited).
+    n_hetero_atoms, n_water_atoms, n_altloc_atoms : int
+        First-model atoms of non-water HETATM groups, of waters, and with an altloc.
+    warnings : tuple of str
+        What was skipped or ignored while reading.
+    atoms : AtomTable
+        Names, elements, residues, B-factors and occupancies of the atoms of ``coords``.
+    """
+
+    path: Path
+    source_format: str
+    entry_id: str
+    title: str
+    coords: NDArray[np.float64]
+    atom_residue: NDArray[np.int64]
+    segments: tuple[BackboneSegment, ...]
+    ss_source: str
+    chains: tuple[ChainSummary, ...]
+    n_models: int
+    n_hetero_atoms: int
+    n_water_atoms: int
+    n_altloc_atoms: int
+    warnings: tuple[str, ...]
+    atoms: AtomTable
+    _template: gemmi.Structure = field(repr=False)
+    _text: str = field(repr=False)
+
+    @property
+    def n_atoms(self) -> int:
+        """Atoms of the first model (rows of ``coords``)."""
+        return len(self.coords)
+
+    @property
+    def n_residues(self) -> int:
+        """Rows of the residue table (backbone residues of all segments)."""
+        return sum(len(s) for s in self.segments)
+
+
+def frozen(array: np.ndarray) -> np.ndarray:
+    """``array`` as a contiguous, read-only array: how a structure keeps its arrays."""
+    array = np.ascontiguousarray(array)
+    array.flags.writeable = False
+    return array

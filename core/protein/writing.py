@@ -1,0 +1,185 @@
+"""Writing edited coordinates back as PDB or mmCIF, keeping everything else of the input."""
+
+from __future__ import annotations
+
+import contextlib
+import gzip
+import os
+import tempfile
+from pathlib import Path
+
+import gemmi
+import numpy as np
+from numpy.typing import NDArray
+
+from core.protein.structure import Structure, StructureError
+
+_PDB_SUFFIXES = (".pdb", ".ent")
+_MMCIF_SUFFIXES = (".cif", ".mmcif")
+_COORDINATE_RECORDS = ("ATOM", "HETATM", "ANISOU", "MODEL", "TER")
+# Order of the PDB header records (wwPDB format 3.3), used to put back the records of the
+# input that gemmi does not write (COMPND, SOURCE, AUTHOR, JRNL, REVDAT, FORMUL, ...).
+_PDB_HEADER_ORDER = (
+    "HEADER", "OBSLTE", "TITLE", "SPLIT", "CAVEAT", "COMPND", "SOURCE", "KEYWDS", "EXPDTA",
+    "NUMMDL", "MDLTYP", "AUTHOR", "REVDAT", "SPRSDE", "JRNL", "REMARK", "DBREF", "DBREF1",
+    "DBREF2", "SEQADV", "SEQRES", "MODRES", "HET", "HETNAM", "HETSYN", "FORMUL", "HELIX",
+    "SHEET", "SSBOND", "LINK", "CISPEP", "SITE", "CRYST1", "ORIGX1", "ORIGX2", "ORIGX3",
+    "SCALE1", "SCALE2", "SCALE3", "MTRIX1", "MTRIX2", "MTRIX3",
+)  # fmt: skip
+
+
+
+def write_structure(
+    structure: Structure,
+    coords: NDArray[np.float64],
+    path: str | os.PathLike[str],
+    *,
+    overwrite: bool = False,
+) -> Path:
+    """Write ``structure`` with its first-model atoms moved to ``coords``.
+
+    Everything else is kept: header records, SEQRES, HELIX/SHEET, SSBOND/LINK, CONECT,
+    hetero groups, waters, B-factors, occupancies, altlocs, numbering (auth and label
+    ids in mmCIF) and the other models of a multi-model entry (unchanged). Anisotropic
+    displacement parameters are written as read (not rotated with moved residues).
+    mmCIF input written as mmCIF keeps every category of the input; only the atom
+    records are regenerated.
+
+    Parameters
+    ----------
+    structure : Structure
+    coords : (structure.n_atoms, 3) float array, Å
+        New positions in the order of ``structure.coords``.
+    path : str or path-like
+        Output file; the format follows the extension: .pdb/.ent (PDB) or .cif/.mmcif
+        (mmCIF), optionally followed by .gz.
+    overwrite : bool
+        Allow replacing an existing file, including the input file.
+
+    Returns
+    -------
+    Path
+        The file written. The write is atomic (temporary file, then rename).
+
+    Raises
+    ------
+    StructureError
+        Wrong shape or non-finite ``coords``, unknown extension, or content the target
+        format cannot hold (e.g. chain ids longer than 2 characters in PDB).
+    FileExistsError
+        ``path`` exists and ``overwrite`` is False.
+    """
+    path = Path(path)
+    coords = _checked_coords(structure, coords)
+    fmt, compress = _output_format(path)
+    if not overwrite and path.exists():
+        same = structure.path.exists() and path.samefile(structure.path)
+        raise FileExistsError(
+            f"{path}: refusing to overwrite {'the input file' if same else 'an existing file'}"
+        )
+    st = structure._template.clone()
+    _set_positions(st[0], coords)
+    try:
+        text = _pdb_text(st, structure) if fmt == "pdb" else _mmcif_text(st, structure)
+    except RuntimeError as exc:
+        raise StructureError(f"{path}: cannot write {fmt.upper()} ({exc})") from None
+    data = text.encode()
+    _atomic_write(path, gzip.compress(data, mtime=0) if compress else data)
+    return path
+
+
+def _checked_coords(structure: Structure, coords: NDArray[np.float64]) -> np.ndarray:
+    coords = np.asarray(coords, dtype=np.float64)
+    if coords.shape != structure.coords.shape:
+        raise StructureError(f"coords must have shape {structure.coords.shape}; got {coords.shape}")
+    if not np.isfinite(coords).all():
+        raise StructureError(f"coords contains {int((~np.isfinite(coords)).sum())} non-finite value(s)")
+    return coords
+
+
+def _output_format(path: Path) -> tuple[str, bool]:
+    """('pdb' | 'mmcif', gzip?) from the file name."""
+    name = path.name.lower()
+    compress = name.endswith(".gz")
+    stem = name.removesuffix(".gz")
+    if stem.endswith(_PDB_SUFFIXES):
+        return "pdb", compress
+    if stem.endswith(_MMCIF_SUFFIXES):
+        return "mmcif", compress
+    raise StructureError(f"{path}: unknown extension; use .pdb, .ent, .cif or .mmcif (optionally + .gz)")
+
+
+def _set_positions(model: gemmi.Model, coords: np.ndarray) -> None:
+    rows = iter(np.round(coords, 3).tolist())
+    for ch in model:
+        for res in ch:
+            for atom in res:
+                atom.pos = gemmi.Position(*next(rows))
+
+
+def _pdb_text(st: gemmi.Structure, structure: Structure) -> str:
+    options = gemmi.PdbWriteOptions()
+    options.preserve_serial = True
+    options.conect_records = True
+    text = st.make_pdb_string(options)
+    if structure.source_format == "pdb":
+        text = _with_input_header(text, structure._text)
+    return text
+
+
+def _with_input_header(written: str, original: str) -> str:
+    """Insert into gemmi's PDB output the header records of the input of a type gemmi did
+    not write (COMPND, SOURCE, AUTHOR, REVDAT, JRNL, FORMUL, SITE, ...), in standard order."""
+    rank = {record: k for k, record in enumerate(_PDB_HEADER_ORDER)}
+    lines = written.splitlines()
+    n_header = next(
+        (k for k, line in enumerate(lines) if _record(line) in _COORDINATE_RECORDS), len(lines)
+    )
+    present = {_record(line) for line in lines}
+    extra = []
+    for line in original.splitlines():
+        record = _record(line)
+        if record in _COORDINATE_RECORDS:
+            break
+        if record in rank and record not in present:
+            extra.append(line.rstrip("\r"))
+    if not extra:
+        return written
+    keyed = []
+    last = 0
+    for line in lines[:n_header]:
+        last = rank.get(_record(line), last)
+        keyed.append((last, line))
+    keyed += [(rank[_record(line)], line) for line in extra]
+    header = [line for _, line in sorted(keyed, key=lambda item: item[0])]
+    return "\n".join(header + lines[n_header:]) + "\n"
+
+
+def _record(line: str) -> str:
+    return line[:6].strip()
+
+
+def _mmcif_text(st: gemmi.Structure, structure: Structure) -> str:
+    if structure.source_format != "mmcif":
+        return st.make_mmcif_document().as_string()
+    doc = gemmi.cif.read_string(structure._text)
+    groups = gemmi.MmcifOutputGroups(False, atoms=True, group_pdb=True, auth_all=True)
+    st.update_mmcif_block(doc[0], groups)
+    return doc.as_string()
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    """Write ``data`` to a temporary file next to ``path``, then rename it onto ``path``."""
+    mode = path.stat().st_mode & 0o777 if path.exists() else 0o644
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as out:
+            out.write(data)
+            out.flush()
+            os.fsync(out.fileno())
+        os.chmod(tmp, mode)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise

@@ -1,0 +1,146 @@
+"""One entry point for every kind of surface, level by level: what a surface panel or the
+``surface`` command asks for (vertices, faces and per-vertex colours).
+
+Kinds: ``ses`` (the molecular surface itself, one level), ``globe`` and ``dna`` (spline
+surfaces, levels 0-5, fractional levels allowed, coloured by a 64 × 64 texture),
+``remesh`` (6 · 4**level triangles) and ``map`` (a density map's wavelet levels,
+contoured).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from core.protein.structure import AtomTable
+from core.surfaces.globe import ShapeSurface, cylinder, globe
+from core.surfaces.mesh import TriangleMesh
+from core.surfaces.molecular import COLOURINGS, MolecularSurface, molecular_surface
+from core.surfaces.properties import atom_charges, electrostatic_potential, nearest_atom_values
+from core.surfaces.remesh import remesh
+from core.surfaces.volume import DensityMap, model_density
+
+KINDS = ("ses", "globe", "dna", "remesh", "map")
+
+UNITS = {"potential": "kcal/(mol·e)", "curvature": "1/Å", "bfactor": "Å²"}
+
+
+@dataclass(frozen=True, eq=False)
+class LevelledSurface:
+    """A surface of one kind at every level from 0 to ``max_level``.
+
+    Attributes
+    ----------
+    kind : str
+    max_level : int
+        The finest level (the surface as built).
+    errors : tuple of (level, rms error Å) pairs
+        How far each level lies from what it approximates (empty for ``ses``); for
+        ``map``, the rms difference of the map values at each level from the map.
+    fractional : bool
+        Whether levels between integers are defined (spline surfaces).
+    """
+
+    kind: str
+    max_level: int
+    errors: tuple[tuple[int, float], ...]
+    fractional: bool
+    _mesh: Callable[[float], TriangleMesh]
+    _colour: Callable[[str, float, TriangleMesh], np.ndarray]
+
+    def view(self, level: float | None = None, colouring: str | None = None) -> tuple[TriangleMesh, np.ndarray | None]:
+        """The mesh at ``level`` (default the finest) and its per-vertex ``colouring``
+        (one of :data:`core.surfaces.molecular.COLOURINGS`, or None)."""
+        level = self.max_level if level is None else float(level)
+        if not 0 <= level <= self.max_level or (not self.fractional and level != int(level)):
+            kind = "a level" if self.fractional else "an integer level"
+            raise ValueError(f"{self.kind}: level must be {kind} in [0, {self.max_level}]; got {level:g}")
+        if colouring is not None and colouring not in COLOURINGS:
+            raise ValueError(f"colouring must be one of {', '.join(COLOURINGS)}; got {colouring!r}")
+        mesh = self._mesh(level)
+        return mesh, None if colouring is None else self._colour(colouring, level, mesh)
+
+
+def build_surface(
+    kind: str,
+    atoms: AtomTable | None = None,
+    *,
+    density: DensityMap | None = None,
+    site: np.ndarray | None = None,
+    contour: float = 1.0,
+    probe: float = 1.4,
+    spacing: float | None = None,
+) -> LevelledSurface:
+    """Build the surface of ``kind`` (one of :data:`KINDS`).
+
+    Parameters
+    ----------
+    kind : str
+    atoms : AtomTable, optional
+        The model (needed by every kind except ``map`` with a ``density``).
+    density : DensityMap, optional
+        For ``map``: the map to contour (default: computed from ``atoms``).
+    site : (n_atoms,) bool, optional
+        For ``remesh``: the site atoms (e.g. a ligand); they are left out of the surface
+        and the patch within 10 Å of them is remeshed instead of the whole surface.
+    contour : float
+        For ``map``: the contour in rms deviations above the mean of the map.
+    probe, spacing : float, Å
+        Probe radius and grid step of the molecular surface.
+    """
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {', '.join(KINDS)}; got {kind!r}")
+    if kind == "map":
+        return _map_surface(density if density is not None else model_density(_needed(atoms)), atoms, contour)
+    atoms = _needed(atoms)
+    surface = molecular_surface(atoms, probe=probe, spacing=spacing, exclude=site)
+    if kind == "ses":
+        return LevelledSurface("ses", 0, (), False, lambda _: surface.mesh, lambda c, _, m: surface.colour(c, m.vertices))
+    if kind == "remesh":
+        result = remesh(surface, site=None if site is None else atoms.coords[site])
+        return LevelledSurface(
+            "remesh", len(result.meshes) - 1, tuple(enumerate(result.rms_error)), False,
+            lambda level: result.meshes[int(level)], lambda c, _, m: surface.colour(c, m.vertices),
+        )  # fmt: skip
+    shape = globe(surface) if kind == "globe" else cylinder(surface)
+    return _spline_surface(kind, shape, surface)
+
+
+def _spline_surface(kind: str, shape: ShapeSurface, surface: MolecularSurface) -> LevelledSurface:
+    spline = shape.surface
+    textures: dict[str, np.ndarray] = {}
+
+    def texture(colouring: str, level: float, mesh: TriangleMesh) -> np.ndarray:
+        if colouring not in textures:
+            textures[colouring] = surface.colour(colouring, spline.samples)
+        values = textures[colouring]
+        return np.concatenate([values[0, :1], values[1:-1].reshape(-1), values[-1, :1]]) if spline.poles else values.reshape(-1)
+
+    errors = tuple((level, spline.rms_error(level)) for level in range(spline.level + 1))
+    return LevelledSurface(kind, spline.level, errors, True, spline.mesh, texture)
+
+
+def _map_surface(density: DensityMap, atoms: AtomTable | None, contour: float) -> LevelledSurface:
+    value = density.sigma_level(contour)
+    levels = {level: density.at_level(level) for level in range(density.max_level + 1)}
+    errors = tuple(
+        (level, float(np.sqrt(np.mean((m.values - density.values) ** 2)))) for level, m in levels.items()
+    )
+
+    def colour(colouring: str, level: float, mesh: TriangleMesh) -> np.ndarray:
+        if atoms is None or colouring == "curvature":
+            raise ValueError(f"a map can be coloured by the potential or B-factors of a model, not by {colouring}")
+        keep = atoms.category != "water"
+        if colouring == "potential":
+            return electrostatic_potential(mesh.vertices, atoms.coords[keep], atom_charges(atoms)[keep])
+        return nearest_atom_values(mesh.vertices, atoms.coords[keep], atoms.b_factor[keep])
+
+    return LevelledSurface("map", density.max_level, errors, False, lambda level: levels[int(level)].contour(value), colour)
+
+
+def _needed(atoms: AtomTable | None) -> AtomTable:
+    if atoms is None:
+        raise ValueError("this kind of surface needs a model (atoms)")
+    return atoms

@@ -1,0 +1,146 @@
+"""Density maps: read CCP4/MRC files or compute one from a model (gemmi), 3-D wavelet
+levels (PyWavelets) and contour surfaces (marching cubes).
+
+A map is a grid of values with an affine map from grid indices to Å, so that skewed unit
+cells need no resampling. Wavelet level ``L`` of a map with ``n`` levels keeps the
+approximation at depth ``n`` and the ``L`` coarsest detail levels: level ``n`` is the map
+itself, level 0 its coarsest approximation.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+
+import gemmi
+import numpy as np
+import pywt
+from numpy.typing import NDArray
+from skimage.measure import marching_cubes
+
+from core.protein.structure import AtomTable
+from core.surfaces.mesh import TriangleMesh
+
+WAVELET = "bior4.4"
+"""The biorthogonal CDF 9/7 wavelet (symmetric filters, as in JPEG 2000)."""
+
+
+class MapError(ValueError):
+    """A file that cannot be read as a density map."""
+
+
+UNKNOWN_B = 20.0
+"""B-factor (Å²) used for atoms whose file gives none (0): a typical value for a protein."""
+
+
+@dataclass(frozen=True, eq=False)
+class DensityMap:
+    """Values on a grid.
+
+    Attributes
+    ----------
+    values : (nx, ny, nz) float32
+    origin : (3,) float64, Å
+        Position of grid point (0, 0, 0).
+    axes : (3, 3) float64, Å
+        Rows: the steps of the grid along its three axes (a diagonal of spacings for an
+        orthogonal cell).
+    """
+
+    values: NDArray[np.float32]
+    origin: NDArray[np.float64]
+    axes: NDArray[np.float64]
+
+    @cached_property
+    def _coefficients(self) -> list:
+        return pywt.wavedecn(self.values, WAVELET, mode="symmetric", level=self.max_level)
+
+    @property
+    def max_level(self) -> int:
+        """Number of wavelet levels of the grid (at least 1)."""
+        return max(1, pywt.dwtn_max_level(self.values.shape, WAVELET))
+
+    def at_level(self, level: int) -> DensityMap:
+        """The map reconstructed from its approximation and ``level`` coarsest detail levels."""
+        if isinstance(level, bool) or not isinstance(level, (int, np.integer)) or not 0 <= level <= self.max_level:
+            raise ValueError(f"level must be an integer in [0, {self.max_level}]; got {level!r}")
+        if level == self.max_level:
+            return self
+        kept = self._coefficients[: level + 1]
+        dropped = [{key: np.zeros_like(c) for key, c in detail.items()} for detail in self._coefficients[level + 1 :]]
+        values = pywt.waverecn(kept + dropped, WAVELET, mode="symmetric")
+        values = values[tuple(slice(0, n) for n in self.values.shape)]
+        return DensityMap(values.astype(np.float32), self.origin, self.axes)
+
+    def sigma_level(self, contour: float) -> float:
+        """The value ``mean + contour · rms deviation`` of the map."""
+        return float(self.values.mean() + contour * self.values.std())
+
+    def contour(self, value: float) -> TriangleMesh:
+        """Isosurface at ``value`` (normals towards lower density)."""
+        if not self.values.min() < value < self.values.max():
+            raise ValueError(f"contour {value:g} lies outside the map's range [{self.values.min():g}, {self.values.max():g}]")
+        vertices, faces, _, _ = marching_cubes(self.values, value, allow_degenerate=False)
+        return TriangleMesh(self.origin + vertices @ self.axes, faces[:, ::-1])
+
+
+def read_map(path: str | os.PathLike[str]) -> DensityMap:
+    """Read a CCP4/MRC map (optionally gzipped); the whole unit cell, gaps filled with the mean."""
+    path = Path(path)
+    if not path.is_file():
+        raise MapError(f"{path}: no such file")
+    try:
+        ccp4 = gemmi.read_ccp4_map(str(path))
+        ccp4.setup(float("nan"), gemmi.MapSetup.Full)
+    except (RuntimeError, ValueError) as exc:
+        raise MapError(f"{path}: not a readable CCP4/MRC map ({exc})") from None
+    grid = ccp4.grid
+    values = np.array(grid.array, dtype=np.float32)
+    finite = np.isfinite(values)
+    if not finite.any():
+        raise MapError(f"{path}: the map holds no finite values")
+    values[~finite] = values[finite].mean()
+    orth = np.array(grid.unit_cell.orth.mat.tolist())
+    axes = (orth / np.array(values.shape)).T
+    origin = np.array([ccp4.header_float(k) for k in (50, 51, 52)], dtype=np.float64)
+    return DensityMap(values, origin, axes)
+
+
+def model_density(atoms: AtomTable, *, spacing: float = 0.75, resolution: float = 3.0, margin: float = 5.0) -> DensityMap:
+    """Electron density of the non-water atoms of a model (gemmi's DensityCalculatorX:
+    IT92 form factors, each atom blurred by its B-factor), in a box ``margin`` Å wider
+    than the atoms, at a ``resolution`` (Å) and grid ``spacing`` (Å). Atoms without a
+    B-factor (0, as in NMR models) get :data:`UNKNOWN_B`."""
+    keep = atoms.category != "water"
+    if not keep.any():
+        raise ValueError(f"{atoms.entry_id}: no atoms to compute a density from")
+    coords = atoms.coords[keep]
+    low = coords.min(axis=0) - margin
+    size = coords.max(axis=0) + margin - low
+    st = gemmi.Structure()
+    st.cell = gemmi.UnitCell(*size, 90, 90, 90)
+    st.spacegroup_hm = "P 1"
+    residue = gemmi.Residue()
+    residue.name = "UNK"
+    for xyz, element, b, occupancy in zip(coords - low, atoms.element[keep], atoms.b_factor[keep], atoms.occupancy[keep], strict=True):
+        atom = gemmi.Atom()
+        atom.pos = gemmi.Position(*xyz)
+        atom.element = gemmi.Element(element)
+        atom.b_iso = b if b > 0 else UNKNOWN_B  # a zero B gives NaN densities
+        atom.occ = occupancy
+        residue.add_atom(atom)
+    chain = gemmi.Chain("A")
+    chain.add_residue(residue)
+    model = gemmi.Model("1")
+    model.add_chain(chain)
+    st.add_model(model)
+    calculator = gemmi.DensityCalculatorX()
+    calculator.d_min = resolution
+    calculator.grid.set_unit_cell(st.cell)
+    calculator.grid.spacegroup = gemmi.SpaceGroup("P 1")
+    calculator.grid.set_size_from_spacing(spacing, gemmi.GridSizeRounding.Up)
+    calculator.add_model_density_to_grid(st[0])
+    values = np.array(calculator.grid.array, dtype=np.float32)
+    return DensityMap(values, low, np.diag(size / np.array(values.shape)))

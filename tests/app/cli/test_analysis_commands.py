@@ -1,0 +1,230 @@
+"""The ``analyze`` and ``compare`` commands on real entries, through ``main``."""
+
+import csv
+import json
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.image import imread
+
+from app.main import main
+from core.protein.reading import read_structure
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+ENTRIES = ["1UBQ.pdb.gz", "1TIM.pdb.gz", "4HHB.pdb.gz", "1F9V.pdb.gz", "2O9S_A.pdb.gz", "7Z9T.cif.gz"]
+SUMMARY_HEADER = ["ribbon", "mode", "depth", "class", "n_residues", "rms", "sd"]
+
+
+def run(capsys, *argv) -> tuple[int, str, str]:
+    status = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def read_csv(path: Path) -> list[dict[str, str]]:
+    with path.open(newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+@pytest.fixture(scope="module")
+def database(tmp_path_factory) -> Path:
+    """A folder of entries in two sub-folders, a DNA-only entry, a broken file and a non-structure file."""
+    folder = tmp_path_factory.mktemp("database")
+    (folder / "more").mkdir()
+    for k, name in enumerate(ENTRIES):
+        shutil.copy(DATA / name, folder / ("more" if k % 2 else ".") / name)
+    shutil.copy(DATA / "1BNA.pdb.gz", folder / "1BNA.pdb.gz")
+    (folder / "broken.cif").write_text("data_broken\n_atom_site.id 1\n")
+    (folder / "notes.txt").write_text("not a structure, not picked up\n")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def analysed(database, tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("analysis")
+    status = main(["analyze", str(database), "-o", str(out), "--jobs", "2"])
+    assert status == 0
+    return out
+
+
+def test_analyze_writes_the_tables_and_reports_skipped_files(database, tmp_path, capsys):
+    status, out, err = run(capsys, "analyze", database, "-o", tmp_path / "out", "--jobs", "2", "--max-depth", "4")
+    assert status == 0
+    assert "analysing" in err and "100%" in err  # the progress bar
+    assert "skipped" in err and "1BNA.pdb.gz" in err and "broken.cif" in err
+    skipped = read_csv(tmp_path / "out" / "skipped.csv")
+    assert sorted(Path(row["file"]).name for row in skipped) == ["1BNA.pdb.gz", "broken.cif"]
+    assert all(row["reason"] for row in skipped)
+    residues = read_csv(tmp_path / "out" / "residues.csv")
+    expected = sum(read_structure(DATA / name).n_residues for name in ENTRIES)
+    assert len(residues) == expected
+    assert f"analysed {len(ENTRIES)} file(s)" in out and f"{expected} residues" in out
+    assert "67 residues in 1 file(s) without HELIX/SHEET records: helix/sheet/other computed by DSSP" in out
+    assert re.search(r"rms at 1/4 of the segments \(depth 2\), Å +\d\.\d\d +\d\.\d\d +2\.1\n", out)
+    assert re.search(r"rms at 1/8 of the segments \(depth 3\), Å +\d\.\d\d +\d\.\d\d +3\.3\n", out)
+    assert re.search(r"depth where the rms passes 3\.8 Å +[23]\.\d\d +[23]\.\d\d ", out)
+
+
+def test_summary_has_exactly_the_contract_columns_and_agrees_with_the_residue_rows(analysed):
+    with (analysed / "summary.csv").open(newline="") as handle:
+        assert next(csv.reader(handle)) == SUMMARY_HEADER
+    summary = read_csv(analysed / "summary.csv")
+    assert {(r["ribbon"], r["mode"]) for r in summary} == {
+        (ribbon, mode) for ribbon in ("peptide", "calpha") for mode in ("integer", "fractional")
+    }
+    assert {r["class"] for r in summary} == {"all", "helix", "sheet", "other"}
+    assert {float(r["depth"]) for r in summary if r["mode"] == "fractional"} == set(np.arange(0, 6.01, 0.5))
+    residues = read_csv(analysed / "residues.csv")
+    for row in summary:
+        name = f"{row['ribbon']}_{row['mode']}_{row['depth']}"
+        values = np.array([float(r[name]) for r in residues
+                           if r[name] and (row["class"] == "all" or r["class"] == row["class"])])
+        assert int(row["n_residues"]) == len(values)
+        assert float(row["rms"]) == pytest.approx(np.sqrt(np.mean(values**2)), abs=2e-3)  # residues.csv: 3 decimals
+        assert float(row["sd"]) == pytest.approx(np.std(values), abs=2e-3)
+    by_key = {(r["ribbon"], r["mode"], r["depth"], r["class"]): float(r["rms"]) for r in summary}
+    assert by_key[("calpha", "integer", "0", "all")] == 0.0
+    assert 0.9 < by_key[("peptide", "integer", "0", "all")] < 1.5
+    assert by_key[("peptide", "integer", "2", "all")] < by_key[("peptide", "integer", "3", "all")]
+
+
+def test_fig7_shows_every_class(analysed):
+    image = imread(analysed / "fig7.png")
+    assert image.shape[0] > 600 and image.shape[1] > 800
+    red, green, blue = image[..., 0], image[..., 1], image[..., 2]
+    assert np.count_nonzero((red > 0.7) & (green < 0.3) & (blue < 0.3)) > 200  # helix series
+    assert np.count_nonzero((blue > 0.6) & (red < 0.3)) > 200  # sheet series
+
+
+def test_one_process_and_a_dask_cluster_give_the_same_numbers(database, analysed, tmp_path, capsys):
+    from dask.distributed import LocalCluster
+
+    status, _, _ = run(capsys, "analyze", database, "-o", tmp_path / "serial", "--jobs", "1")
+    assert status == 0
+    with LocalCluster(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None) as cluster:
+        status, _, _ = run(capsys, "analyze", database, "-o", tmp_path / "dask", "--scheduler", cluster.scheduler_address)
+    assert status == 0
+    expected = (analysed / "summary.csv").read_text()
+    assert (tmp_path / "serial" / "summary.csv").read_text() == expected
+    assert (tmp_path / "dask" / "summary.csv").read_text() == expected
+    assert (tmp_path / "dask" / "residues.csv").read_text() == (analysed / "residues.csv").read_text()
+
+
+def test_reference_selection_options(tmp_path, capsys):
+    args = ["analyze", DATA / "4HHB.pdb.gz", DATA / "2O9S_A.pdb.gz", "--jobs", "1", "--chains", "longest",
+            "--gaps", "join", "--termini", "calpha", "--ss", "records"]
+    status, out, _ = run(capsys, *args, "-o", tmp_path / "reference")
+    assert status == 0 and "2 curves, 213 residues" in out  # 4HHB chain D (146, in three pieces) + 2O9S (67)
+    assert "67 residues in 1 file(s) without HELIX/SHEET records: counted only in class 'all'" in out
+    residues = read_csv(tmp_path / "reference" / "residues.csv")
+    assert {r["chain"] for r in residues if r["entry"] == "4HHB"} == {"D"}
+    assert {r["curve"] for r in residues} == {"0"}
+    assert {r["class"] for r in residues if r["file"].endswith("2O9S_A.pdb.gz")} == {""}  # no records: only in 'all'
+    summary = read_csv(tmp_path / "reference" / "summary.csv")
+    helix = next(r for r in summary if (r["ribbon"], r["mode"], r["depth"], r["class"]) == ("peptide", "integer", "0", "helix"))
+    assert int(helix["n_residues"]) == sum(r["class"] == "helix" for r in residues)
+
+
+def test_analyze_refuses_to_overwrite_results(tmp_path, capsys):
+    assert run(capsys, "analyze", DATA / "1TIM.pdb.gz", "-o", tmp_path, "--jobs", "1")[0] == 0
+    before = (tmp_path / "summary.csv").read_text()
+    status, _, err = run(capsys, "analyze", DATA / "1UBQ.pdb.gz", "-o", tmp_path, "--jobs", "1")
+    assert status == 1 and "--overwrite" in err and (tmp_path / "summary.csv").read_text() == before
+    status, out, _ = run(capsys, "analyze", DATA / "1UBQ.pdb.gz", "-o", tmp_path, "--jobs", "1", "--overwrite")
+    assert status == 0 and "76 residues" in out and (tmp_path / "summary.csv").read_text() != before
+    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary files left
+
+
+def test_compare_a_distant_homologue_by_structure_or_by_sequence(capsys):
+    common = ("compare", DATA / "3PTB.pdb.gz", DATA / "3SGB.pdb.gz", "--chains", "A:E", "--steps", "4", "--depths",
+              "2", "--core-cutoff", "3", "--json")
+    reports = {}
+    for pairing in ("auto", "alignment"):
+        status, out, _ = run(capsys, *common, "--pairing", pairing)
+        assert status == 0
+        reports[pairing] = json.loads(out)
+    assert reports["auto"]["pairing"] == "structure" and reports["alignment"]["pairing"] == "alignment"
+    assert reports["auto"]["tm_score"] > reports["alignment"]["tm_score"] + 0.1
+    assert reports["auto"]["n_core"] > 2 * reports["alignment"]["n_core"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "status", "message"),
+    [
+        (["analyze", "{tmp}", "-o", "{tmp}/out"], 1, "no structure files"),
+        (["analyze", DATA / "1UBQ.pdb.gz", "-o", "{tmp}/out", "--fraction-step", "0"], 1, "fraction_step must be > 0"),
+        (["analyze", DATA / "1UBQ.pdb.gz", "-o", "{tmp}/out", "--max-depth", "-2"], 1, "max_depth"),
+        (["analyze", DATA / "1UBQ.pdb.gz", "-o", "{tmp}/out", "--jobs", "0"], 2, "must be >= 1"),
+        (["analyze", DATA / "1UBQ.pdb.gz"], 2, "required: -o/--output"),
+        (["analyze", DATA / "1UBQ.pdb.gz", "-o", DATA / "1UBQ.pdb.gz"], 1, "not a folder"),
+    ],
+)
+def test_analyze_bad_input(argv, status, message, tmp_path, capsys):
+    expect_exit_status([str(a).replace("{tmp}", str(tmp_path)) for a in argv], status, message, capsys)
+
+
+def expect_exit_status(argv: list, status: int, message: str, capsys) -> None:
+    """``main(argv)`` ends with ``status`` (2: argparse's SystemExit) and one line naming the problem."""
+    if status == 2:
+        with pytest.raises(SystemExit) as exit_info:
+            main([str(a) for a in argv])
+        assert exit_info.value.code == 2
+    else:
+        assert main([str(a) for a in argv]) == status
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+
+
+# --------------------------------------------------------------------------- compare
+
+
+def test_compare_two_copies_of_tim(capsys):
+    status, out, _ = run(capsys, "compare", DATA / "1TIM.pdb.gz")  # chains A and B by default
+    assert status == 0
+    assert "chain A (247 residues) vs" in out and "chain B (247 residues)" in out
+    assert "247 residue pairs by numbering" in out
+    assert "TM-score" in out and "normalised by the length of the first chain, 247 residues" in out
+    for label in ("Cα", "C^r at level J − 1", "C^r at level J − 4"):
+        assert label in out
+
+
+def test_compare_json_fields(capsys):
+    status, out, _ = run(capsys, "compare", DATA / "1TIM.pdb.gz", "--chains", "B:A", "--json", "--steps", "4",
+                         "--depths", "2")
+    report = json.loads(out)
+    assert status == 0
+    for key in ("rms_all", "n_pairs", "rms_core", "n_core", "tm_score"):
+        assert key in report
+    assert report["n_pairs"] == 247 and 0 < report["rms_core"] < report["rms_all"] < 3
+    assert 0.8 < report["tm_score"] <= 1 and report["tm_score_length"] == 247
+    assert "normalised by the length of the first chain" in report["tm_score_note"]
+    assert [(f["points"], f["every"], f["start"]) for f in report["fits"]] == (
+        [("CA", 1, 1)] + [("CA", 4, s) for s in range(1, 5)] + [("C^r", 1, 1)] + [("C^r", 4, s) for s in range(1, 5)]
+    )
+    assert all(f["rms_core"] >= report["rms_core"] - 1e-4 for f in report["fits"])
+
+
+def test_compare_two_entries_by_alignment_with_a_user_core(capsys):
+    status, out, _ = run(capsys, "compare", DATA / "1TIM.pdb.gz", DATA / "8TIM.pdb.gz", "--chains", "A:A",
+                         "--core", "10-100,150,200-240", "--json")
+    report = json.loads(out)
+    assert status == 0 and report["pairing"] == "alignment" and report["n_pairs"] == 247
+    assert report["n_core"] == 91 + 1 + 41 and report["core_rule"] == "residues given by the user"
+
+
+@pytest.mark.parametrize(
+    ("argv", "status", "message"),
+    [
+        (["compare", DATA / "1UBQ.pdb.gz"], 1, "has one protein chain"),
+        (["compare", DATA / "1TIM.pdb.gz", "--chains", "A:Z"], 1, "no protein chain 'Z'"),
+        (["compare", DATA / "1TIM.pdb.gz", "--chains", "AB"], 2, "expected two chain ids"),
+        (["compare", DATA / "1TIM.pdb.gz", "--core", "900-950"], 1, "no residue '900-950'"),
+        (["compare", DATA / "1TIM.pdb.gz", "--core", "5-6"], 1, "core set has 2 pair(s)"),
+        (["compare", DATA / "nothing.pdb"], 1, "no such file"),
+    ],
+)
+def test_compare_bad_input(argv, status, message, capsys):
+    expect_exit_status(argv, status, message, capsys)

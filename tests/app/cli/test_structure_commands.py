@@ -1,0 +1,166 @@
+"""The headless commands ``info``, ``curve`` and ``edit`` on real entries, through ``main``."""
+
+import csv
+import io
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from app.main import main
+from core.protein.reading import read_structure
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+AWKWARD = ["1L2Y.pdb.gz", "2BEG.pdb.gz", "1LCD.cif.gz", "3JQH.cif.gz", "1EJG.pdb.gz", "1ORC.pdb.gz",
+           "1F9V.pdb.gz", "4HHB.pdb.gz", "1BD2.pdb.gz", "7Z9T.cif.gz", "4YVS.cif.gz", "2K39_CA-only.pdb.gz"]
+
+
+def run(capsys, *argv: str) -> tuple[int, str, str]:
+    status = main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def test_info_json_describes_ubiquitin(capsys):
+    status, out, _ = run(capsys, "info", DATA / "1UBQ.pdb.gz", "--json")
+    report = json.loads(out)
+    assert status == 0
+    assert report["residues"] == 76 and report["chains"][0]["chain"] == "A"
+    assert sum(report["secondary_structure"].values()) == 76
+    assert report["secondary_structure"]["H"] > 10 and report["secondary_structure"]["E"] > 10
+    assert report["secondary_structure_source"] == "HELIX/SHEET records"
+    (segment,) = report["segments"]
+    assert segment["max_level_peptide"] == pytest.approx(math.log2(76), abs=1e-4)
+
+
+def test_info_text_lists_every_segment_of_a_broken_chain(capsys):
+    status, out, _ = run(capsys, "info", DATA / "1F9V.pdb.gz")
+    assert status == 0
+    structure = read_structure(DATA / "1F9V.pdb.gz")
+    assert len(structure.segments) > 1
+    for segment in structure.segments:
+        assert segment.labels[0] in out and segment.labels[-1] in out
+
+
+def read_csv(text: str) -> list[dict]:
+    return list(csv.DictReader(io.StringIO(text)))
+
+
+def test_curve_csv_has_the_contract_header_and_consistent_rows(capsys):
+    status, out, _ = run(capsys, "curve", DATA / "1UBQ.pdb.gz", "--level", "3.5", "--csv")
+    assert status == 0
+    assert out.splitlines()[0] == "chain,segment,resseq,icode,resname,ss,ca_x,ca_y,ca_z,cr_x,cr_y,cr_z,dist"
+    rows = read_csv(out)
+    assert len(rows) == 76 and {r["ss"] for r in rows} <= {"H", "E", "C"}
+    ca = np.array([[float(r[f"ca_{a}"]) for a in "xyz"] for r in rows])
+    cr = np.array([[float(r[f"cr_{a}"]) for a in "xyz"] for r in rows])
+    assert np.allclose(np.linalg.norm(ca - cr, axis=1), [float(r["dist"]) for r in rows], atol=2e-3)
+    assert np.sqrt(np.mean(np.sum((ca - cr) ** 2, axis=1))) > 2.0  # a smooth low-resolution curve
+
+
+def test_curve_defaults_to_full_resolution_and_calpha_passes_through_calpha(capsys):
+    _, out, _ = run(capsys, "curve", DATA / "1UBQ.pdb.gz", "--ribbon", "calpha", "--csv")
+    assert max(float(r["dist"]) for r in read_csv(out)) < 1e-3
+    _, above, _ = run(capsys, "curve", DATA / "1UBQ.pdb.gz", "--csv", "--level", "20")
+    _, full, _ = run(capsys, "curve", DATA / "1UBQ.pdb.gz", "--csv")
+    assert above == full
+
+
+def test_curve_uses_each_segments_own_maximum_level(capsys):
+    _, out, _ = run(capsys, "curve", DATA / "1F9V.pdb.gz", "--chain", "A", "--csv", "--level", "5.5")
+    rows = read_csv(out)
+    segments = {r["segment"] for r in rows}
+    assert len(segments) == len(read_structure(DATA / "1F9V.pdb.gz").segments)
+    # a segment shorter than 2**5.5 residues is at full resolution at level 5.5
+    short = [r for r in rows if r["segment"] == "2"]  # 19 residues: log2 19 < 5.5
+    _, full, _ = run(capsys, "curve", DATA / "1F9V.pdb.gz", "--chain", "A", "--csv")
+    assert short == [r for r in read_csv(full) if r["segment"] == "2"]
+
+
+def test_curve_of_multicharacter_chains(capsys):
+    status, out, _ = run(capsys, "curve", DATA / "7Z9T.cif.gz", "--chain", "BBB", "--csv")
+    assert status == 0 and {r["chain"] for r in read_csv(out)} == {"BBB"}
+
+
+@pytest.mark.parametrize("name", AWKWARD)
+def test_zero_edit_reproduces_every_awkward_entry(capsys, tmp_path, name):
+    structure = read_structure(DATA / name)
+    segment = structure.segments[0]
+    suffix = ".cif" if name.endswith(".cif.gz") else ".pdb"
+    out = tmp_path / f"same{suffix}"
+    status, printed, err = run(capsys, "edit", DATA / name, "--chain", segment.chain, "--level", "2",
+                               "--point", "3", "--move", "0,0,0", "-o", out)
+    assert status == 0, err
+    assert "moved 0 residues" in printed
+    assert np.allclose(read_structure(out).coords, structure.coords, atol=5e-4)
+
+
+def test_edit_at_the_finest_level_moves_four_residues(capsys, tmp_path):
+    out = tmp_path / "edited.pdb"
+    status, printed, _ = run(capsys, "edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "6.25",
+                             "--point", "65", "--move", "2,0,-1", "-o", out)
+    assert status == 0 and "moved 4 residues" in printed
+    before, after = read_structure(DATA / "1UBQ.pdb.gz"), read_structure(out)
+    moved = np.flatnonzero(np.linalg.norm(after.coords - before.coords, axis=1) > 1e-3)
+    residues = np.unique(before.atom_residue[moved])
+    assert len(residues) == 4 and np.all(np.diff(residues) == 1)
+
+
+def test_edit_of_a_residue_curve_point(capsys, tmp_path):
+    out = tmp_path / "tugged.cif"
+    status, printed, _ = run(capsys, "edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "4",
+                             "--residue", "35", "--move", "0,3,0", "-o", out)
+    assert status == 0 and "moved" in printed
+    assert not np.allclose(read_structure(out).coords, read_structure(DATA / "1UBQ.pdb.gz").coords, atol=1e-2)
+
+
+def test_edit_never_overwrites_without_asking(capsys, tmp_path):
+    out = tmp_path / "existing.pdb"
+    out.write_text("keep me")
+    status, _, err = run(capsys, "edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "3",
+                         "--point", "2", "--move", "1,0,0", "-o", out)
+    assert status == 1 and "--overwrite" in err and out.read_text() == "keep me"
+    status, _, _ = run(capsys, "edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "3",
+                       "--point", "2", "--move", "1,0,0", "-o", out, "--overwrite")
+    assert status == 0 and read_structure(out).n_atoms == read_structure(DATA / "1UBQ.pdb.gz").n_atoms
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["info", "missing.pdb"], "no such file"),
+        (["info", DATA / "1BNA.pdb.gz"], "no protein chain"),
+        (["curve", DATA / "1UBQ.pdb.gz", "--chain", "Z"], "no protein chain 'Z'"),
+        (["curve", DATA / "1UBQ.pdb.gz", "--level", "-1"], "--level must be >= 0"),
+        (["edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "3", "--point", "99", "--move", "1,0,0", "-o", "x.pdb"],
+         "index must be an integer in \\[0, 10\\]"),
+        (["edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--segment", "3", "--level", "3", "--point", "1", "--move",
+          "1,0,0", "-o", "x.pdb"], "has 1 segment"),
+        (["edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "3", "--residue", "500", "--move", "1,0,0", "-o",
+          "x.pdb"], "no residue 500"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_status_1(capsys, tmp_path, monkeypatch, argv, message):
+    monkeypatch.chdir(tmp_path)
+    status, _, err = run(capsys, *argv)
+    assert status == 1
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert re.search(message, err)
+
+
+def test_negative_displacements_need_no_equals_sign(capsys, tmp_path):
+    out = tmp_path / "left.pdb"
+    status, printed, _ = run(capsys, "edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "4",
+                             "--point", "8", "--move", "-3,4,-0.5", "-o", out)
+    assert status == 0 and "moved 32 residues" in printed
+
+
+def test_usage_errors_exit_2(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["edit", str(DATA / "1UBQ.pdb.gz"), "--chain", "A", "--level", "3", "--point", "1", "--move", "1,0",
+              "-o", "x.pdb"])
+    assert exit_info.value.code == 2
+    assert "DX,DY,DZ" in capsys.readouterr().err

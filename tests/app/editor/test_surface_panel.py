@@ -1,0 +1,168 @@
+"""The surface panel in a real window under Xvfb: surfaces built off the GUI thread from the
+panel, levels and colourings shown in place, stale after edits, failures reported."""
+
+from pathlib import Path
+
+import numpy as np
+import pyvista as pv
+from pytestqt.qtbot import QtBot
+
+from app.editor.commands import EditCommand
+from app.editor.docks.surfaces import COLOURING_NAMES, KIND_NAMES, STEPS_PER_LEVEL, SurfacePanel
+from app.editor.document import Document
+from app.editor.main_window import MainWindow
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+BUILD_TIMEOUT_MS = 120_000
+GLOBE_FACES = 2 * 64 * 61 + 2 * 64
+"""A 64 × 64 net with the pole rows collapsed: 61 bands of quads and two fans of 64."""
+GLOBE_VERTICES = 62 * 64 + 2
+
+
+def _window(qtbot: QtBot, document: Document) -> MainWindow:
+    window = MainWindow(document)
+    qtbot.addWidget(window)
+    window.show()
+    qtbot.waitExposed(window)
+    return window
+
+
+def _show(qtbot: QtBot, panel: SurfacePanel, kind: str) -> None:
+    """Choose ``kind`` in the panel, tick "Show surface" and wait for the build."""
+    panel.kind.setCurrentIndex(list(KIND_NAMES).index(kind))
+    panel.show_box.setChecked(True)
+    qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
+
+
+def _actor_mesh(window: MainWindow) -> pv.PolyData:
+    return window.plotter.actors["surface"].mapper.dataset
+
+
+def _view(window: MainWindow) -> np.ndarray:
+    window.plotter.render()
+    return np.asarray(window.plotter.screenshot(return_img=True), dtype=int)
+
+
+def test_globe_levels_colourings_and_screenshot(qtbot: QtBot, ubiquitin: Document, tmp_path: Path) -> None:
+    window = _window(qtbot, ubiquitin)
+    panel = window.surface_panel
+    assert "surface" not in window.plotter.actors
+    panel.kind.setCurrentIndex(list(KIND_NAMES).index("globe"))
+    panel.show_box.setChecked(True)
+    assert panel.layer.busy and not panel.busy.isHidden()  # built off the GUI thread, with a busy bar
+    qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
+    assert panel.busy.isHidden()
+    surface = panel.layer.built.surface
+    assert surface.kind == "globe" and surface.max_level == 5
+    assert panel.slider.maximum() == 5 * STEPS_PER_LEVEL and panel.slider.value() == 5 * STEPS_PER_LEVEL
+
+    mesh = _actor_mesh(window)
+    points_array = mesh.GetPoints().GetData()
+    shapes = {}
+    for level in (5, 4, 3):
+        panel.slider.setValue(level * STEPS_PER_LEVEL)
+        assert _actor_mesh(window) is mesh and mesh.GetPoints().GetData() is points_array  # in place
+        assert (mesh.n_cells, mesh.n_points) == (GLOBE_FACES, GLOBE_VERTICES)
+        np.testing.assert_array_equal(mesh.points, surface.view(level)[0].vertices)
+        shapes[level] = np.array(mesh.points)
+        assert f"{dict(surface.errors)[level]:.3f}" in panel.figures.text()
+    assert np.abs(shapes[5] - shapes[3]).max() > 2.0  # level 3 is a smoother globe
+    errors = dict(surface.errors)
+    assert errors[3] > errors[4] > errors[5]
+    panel.slider.setValue(350)
+    assert panel.layer.shown_level() == 3.5 and not np.array_equal(mesh.points, shapes[3])
+
+    panel.slider.setValue(3 * STEPS_PER_LEVEL)
+    images = {}
+    for colouring in COLOURING_NAMES:
+        panel.colouring.setCurrentIndex(list(COLOURING_NAMES).index(colouring))
+        images[colouring] = _view(window)
+    plain, potential = images[None], images["potential"]
+    assert np.mean(np.any(plain != potential, axis=2)) > 0.05
+    assert np.mean(np.any(images["curvature"] != potential, axis=2)) > 0.05
+    assert np.mean(np.any(images["bfactor"] != potential, axis=2)) > 0.05
+    red = potential[..., 0] - potential[..., 2] > 60
+    blue = potential[..., 2] - potential[..., 0] > 60
+    assert blue.sum() > 10 * (images[None][..., 2] - images[None][..., 0] > 60).sum()
+    assert red.sum() > 500 and blue.sum() > 500  # negative and positive patches of ubiquitin
+    assert "kcal/(mol·e)" not in panel.figures.text()  # the B-factor colouring is last
+    assert "Å²" in panel.figures.text()
+
+    panel.colouring.setCurrentIndex(list(COLOURING_NAMES).index("potential"))
+    panel.opacity.setValue(100)
+    assert window.plotter.actors["surface"].prop.opacity == 1.0
+    opaque = _view(window)
+    assert np.mean(np.any(opaque != potential, axis=2)) > 0.02  # the ribbon no longer shows through
+    panel.opacity.setValue(60)
+    panel.parentWidget().raise_()  # the dock's tab
+    shot = tmp_path / "surface.png"
+    window.save_screenshot(shot)
+    assert shot.stat().st_size > 50_000
+
+    panel.show_box.setChecked(False)
+    assert not window.plotter.actors["surface"].GetVisibility()
+    panel.show_box.setChecked(True)  # cached: no new build
+    assert not panel.layer.busy and window.plotter.actors["surface"].GetVisibility()
+
+
+def test_ses_and_remesh_from_the_panel(qtbot: QtBot, ubiquitin: Document) -> None:
+    window = _window(qtbot, ubiquitin)
+    panel = window.surface_panel
+    _show(qtbot, panel, "ses")
+    mesh = _actor_mesh(window)
+    assert panel.layer.built.surface.max_level == 0 and not panel.slider.isEnabled()
+    assert mesh.n_open_edges == 0 and mesh.n_cells > 20_000
+    assert abs(mesh.area - 3700) < 500  # Å², ubiquitin's solvent-excluded surface
+    assert f"{mesh.n_cells} triangles" in panel.figures.text()
+
+    _show(qtbot, panel, "remesh")
+    assert _actor_mesh(window) is mesh  # other triangles under the same actor
+    for level in (5, 4, 3):
+        panel.slider.setValue(level)
+        assert mesh.n_cells == 6 * 4**level
+    ses = panel.layer._cache["ses"]
+    panel.kind.setCurrentIndex(list(KIND_NAMES).index("ses"))  # cached: shown at once
+    assert not panel.layer.busy and panel.layer.built is ses and mesh.n_cells > 20_000
+
+
+def test_edits_make_the_surface_stale_until_recomputed(qtbot: QtBot, ubiquitin: Document) -> None:
+    window = _window(qtbot, ubiquitin)
+    panel = window.surface_panel
+    _show(qtbot, panel, "globe")
+    before = np.array(_actor_mesh(window).points)
+    assert panel.recompute.isHidden()
+    edit = ubiquitin.model.move_point(0, 3.0, 5, np.array([6.0, 0.0, 0.0]))
+    ubiquitin.undo_stack.push(EditCommand(ubiquitin, edit, "move"))
+    assert panel.layer.stale and not panel.recompute.isHidden() and not panel.stale_text.isHidden()
+    ubiquitin.undo_stack.undo()  # the atoms as the surface was built from: fresh again
+    assert not panel.layer.stale and panel.recompute.isHidden()
+    ubiquitin.undo_stack.redo()
+    assert panel.layer.stale
+    panel.recompute.click()
+    assert panel.layer.busy
+    qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
+    assert not panel.layer.stale and panel.recompute.isHidden()
+    np.testing.assert_array_equal(panel.layer.built.coords, ubiquitin.model.coords)
+    assert np.abs(_actor_mesh(window).points - before).max() > 1.0  # the globe follows the moved residues
+
+
+def test_failures_are_reported_and_a_new_file_drops_the_cache(qtbot: QtBot, ubiquitin: Document) -> None:
+    window = _window(qtbot, ubiquitin)
+    panel = window.surface_panel
+    _show(qtbot, panel, "dna")  # ubiquitin has no double helix
+    assert panel.layer.built is None and "DNA cylinder: 1UBQ" in panel.figures.text()
+    assert "surface" not in window.plotter.actors
+    panel.kind.setCurrentIndex(list(KIND_NAMES).index("map"))
+    qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
+    panel.colouring.setCurrentIndex(list(COLOURING_NAMES).index("curvature"))
+    assert "not by curvature" in panel.figures.text()  # drawn plain instead
+    assert window.plotter.actors["surface"].GetVisibility()
+
+    panel.kind.setCurrentIndex(list(KIND_NAMES).index("globe"))
+    qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
+    window.open_file(DATA / "1L2Y.pdb.gz")  # Trp-cage, 20 residues
+    qtbot.waitUntil(lambda: panel.layer.built is not None and not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
+    vertices = _actor_mesh(window).points
+    ca = window.document.model.coords[window.document.ca_rows]
+    assert np.linalg.norm(vertices.mean(axis=0) - ca.mean(axis=0)) < 5.0  # around the new structure
+    assert window.plotter.actors["surface"].GetVisibility()

@@ -1,0 +1,117 @@
+"""Structural alignment: the pairing dynamic programme against every pairing of small
+matrices, and real serine proteases paired by structure where their sequences mislead."""
+
+from itertools import combinations
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from core.analysis.compare import pair_residues, tm_score
+from core.analysis.fold_alignment import GAP, align_structures, monotone_pairs
+from core.analysis.superpose import superpose
+from core.protein.reading import read_structure
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+
+
+def _value(score: np.ndarray, rows: np.ndarray, columns: np.ndarray, gap: float) -> float:
+    """Paired scores less ``gap`` per row or column skipped between the first and last pair."""
+    if len(rows) == 0:
+        return 0.0
+    skipped = (rows[-1] - rows[0] + 1 - len(rows)) + (columns[-1] - columns[0] + 1 - len(columns))
+    return float(score[rows, columns].sum() - gap * skipped)
+
+
+def _best_by_enumeration(score: np.ndarray, gap: float) -> float:
+    n, m = score.shape
+    best = 0.0
+    for k in range(1, min(n, m) + 1):
+        for rows in combinations(range(n), k):
+            for columns in combinations(range(m), k):
+                best = max(best, _value(score, np.array(rows), np.array(columns), gap))
+    return best
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_the_pairing_is_the_best_of_every_order_keeping_pairing(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n, m = rng.integers(1, 6, size=2)
+    score = rng.random((n, m)) ** 3  # mostly small, a few large: gaps pay off sometimes
+    gap = [0.0, 0.1, GAP][seed % 3]
+    rows, columns = monotone_pairs(score, gap)
+    assert np.all(np.diff(rows) > 0) and np.all(np.diff(columns) > 0) and len(rows) == len(columns)
+    assert _value(score, rows, columns, gap) == pytest.approx(_best_by_enumeration(score, gap), abs=1e-12)
+
+
+def _longest_chain_ca(path: Path) -> tuple[list, np.ndarray]:
+    structure = read_structure(path)
+    chains = {}
+    for segment in structure.segments:
+        chains.setdefault(segment.chain, []).append(segment)
+    chain = max(chains.values(), key=lambda segments: sum(len(s) for s in segments))
+    return chain, np.concatenate([s.ca for s in chain])
+
+
+@pytest.fixture(scope="module")
+def trypsin() -> tuple[list, np.ndarray]:
+    return _longest_chain_ca(DATA / "3PTB.pdb.gz")
+
+
+def test_a_shifted_start_is_put_right(trypsin) -> None:
+    _, ca = trypsin
+    moved = ca @ Rotation.from_euler("xyz", [40, -20, 70], degrees=True).as_matrix().T + [10.0, -5.0, 3.0]
+    start = np.arange(len(ca) - 4)
+    pairs_a, pairs_b = align_structures(ca, moved, start, start + 4)  # every residue paired with the 4th after it
+    assert np.array_equal(pairs_a, np.arange(len(ca))) and np.array_equal(pairs_b, pairs_a)
+
+
+def _close_pairs(ca_a: np.ndarray, ca_b: np.ndarray, pairs_a: np.ndarray, pairs_b: np.ndarray) -> tuple[int, float]:
+    """Pairs closer than 3 Å after fitting on them (from all pairs, until the set settles),
+    and the TM-score of that fit over all pairs (normalised by chain a)."""
+    a, b = ca_a[pairs_a], ca_b[pairs_b]
+    close = np.ones(len(a), dtype=bool)
+    for _ in range(20):
+        motion = superpose(a[close], b[close])
+        distance = np.linalg.norm(a - motion.apply(b), axis=1)
+        close, settled = distance < 3.0, np.array_equal(distance < 3.0, close)
+        if settled:
+            break
+    return int(close.sum()), tm_score(distance, len(ca_a))[0]
+
+
+def test_a_distant_homologue_is_paired_by_structure(trypsin) -> None:
+    chain_a, ca_a = trypsin
+    chain_b, ca_b = _longest_chain_ca(DATA / "3SGB.pdb.gz")  # S. griseus proteinase B, 26% identical
+    by_sequence = pair_residues(chain_a, chain_b, "alignment")
+    by_structure = pair_residues(chain_a, chain_b)
+    assert by_structure[2] == "structure"
+    close_sequence, tm_sequence = _close_pairs(ca_a, ca_b, *by_sequence[:2])
+    close_structure, tm_structure = _close_pairs(ca_a, ca_b, *by_structure[:2])
+    assert close_sequence < 60 and close_structure > 100 and tm_structure > tm_sequence + 0.1
+    pairs_a, pairs_b = by_structure[:2]
+    assert np.all(np.diff(pairs_a) > 0) and np.all(np.diff(pairs_b) > 0)
+    # the catalytic triad His57, Asp102, Ser195 (chymotrypsin numbering in both entries) is paired
+    number_a = np.concatenate([s.resseq for s in chain_a])[pairs_a]
+    number_b = np.concatenate([s.resseq for s in chain_b])[pairs_b]
+    for triad in (57, 102, 195):
+        assert number_b[number_a == triad].tolist() == [triad]
+
+
+def test_homologues_keep_most_sequence_pairs_and_fit_better(trypsin) -> None:
+    chain_a, ca_a = trypsin
+    chain_b, ca_b = _longest_chain_ca(DATA / "1BMA.pdb.gz")  # porcine elastase, 41% identical
+    by_sequence = pair_residues(chain_a, chain_b, "alignment")
+    by_structure = pair_residues(chain_a, chain_b, "structure")
+    shared = set(zip(*map(np.ndarray.tolist, by_sequence[:2]))) & set(zip(*map(np.ndarray.tolist, by_structure[:2])))
+    assert len(shared) > 0.8 * len(by_sequence[0]) and len(by_structure[0]) > 200
+    (close_sequence, tm_sequence), (close_structure, tm_structure) = (
+        _close_pairs(ca_a, ca_b, *pairs[:2]) for pairs in (by_sequence, by_structure))
+    assert close_structure > close_sequence + 10 and tm_structure > tm_sequence
+
+
+def test_the_start_must_hold_three_pairs(trypsin) -> None:
+    _, ca = trypsin
+    with pytest.raises(ValueError, match="at least 3 pairs"):
+        align_structures(ca, ca, np.arange(2), np.arange(2))

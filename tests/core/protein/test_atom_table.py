@@ -1,0 +1,58 @@
+"""The per-atom table (names, elements, B-factors, categories) that surfaces and maps use."""
+
+from __future__ import annotations
+
+from collections import Counter
+from pathlib import Path
+
+import gemmi
+import numpy as np
+import pytest
+
+from core.protein.reading import read_atoms, read_structure
+from core.protein.structure import ATOM_CATEGORIES, StructureError
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+
+
+@pytest.mark.parametrize("name", ["1UBQ.pdb.gz", "4HHB.pdb.gz", "4YVS.cif.gz", "1LCD.cif.gz"])
+def test_atom_table_holds_the_atoms_gemmi_reads(name: str) -> None:
+    atoms = read_structure(DATA / name).atoms
+    model = gemmi.read_structure(str(DATA / name))[0]
+    expected = [(cra.atom.name, cra.atom.element.name, cra.residue.name, cra.chain.name,
+                 cra.residue.seqid.num, cra.atom.b_iso, cra.atom.occ) for cra in model.all()]
+    got = list(zip(atoms.name, atoms.element, atoms.resname, atoms.chain, atoms.resseq.tolist(),
+                   atoms.b_factor.tolist(), atoms.occupancy.tolist(), strict=True))
+    assert sorted(got) == sorted(expected)  # gemmi may order chain parts differently
+    assert np.array_equal(atoms.coords, read_structure(DATA / name).coords)
+    assert set(atoms.category) <= set(ATOM_CATEGORIES)
+
+
+def test_categories_of_hemoglobin() -> None:
+    atoms = read_structure(DATA / "4HHB.pdb.gz").atoms
+    counts = Counter(atoms.category.tolist())
+    assert counts["water"] == 221
+    assert set(atoms.resname[atoms.category == "ligand"]) == {"HEM", "PO4"}
+    assert counts["protein"] == 4384
+    # residue ordinals run over the model in file order
+    assert atoms.residue[0] == 0 and np.all(np.diff(atoms.residue) >= 0)
+
+
+def test_read_atoms_accepts_dna_without_protein() -> None:
+    with pytest.raises(StructureError, match="no protein chain"):
+        read_structure(DATA / "1BNA.pdb.gz")
+    atoms = read_atoms(DATA / "1BNA.pdb.gz")
+    assert Counter(atoms.category.tolist()) == {"nucleic": 486, "water": 80}
+    assert atoms.entry_id == "1BNA"
+    assert not atoms.coords.flags.writeable and not atoms.b_factor.flags.writeable
+
+
+def test_altlocs_are_recorded() -> None:
+    atoms = read_structure(DATA / "1EJG.pdb.gz").atoms
+    assert {"", "A", "B"} <= set(atoms.altloc.tolist())
+
+
+def test_read_atoms_reports_bad_files(tmp_path: Path) -> None:
+    (tmp_path / "empty.pdb").write_text("")
+    with pytest.raises(StructureError, match="empty file"):
+        read_atoms(tmp_path / "empty.pdb")

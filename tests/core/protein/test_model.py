@@ -1,0 +1,147 @@
+"""Multiresolution editing of atoms on real structures: locality, rigidity, exact undo, save."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.protein.model import EditableModel
+from core.protein.reading import read_structure
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+
+
+@pytest.fixture(scope="module")
+def ubiquitin():
+    return read_structure(DATA / "1UBQ.pdb.gz")
+
+
+@pytest.fixture
+def model(ubiquitin):
+    return EditableModel(ubiquitin)
+
+
+def moved_residues(model, edit):
+    """Residues (within the segment) with at least one atom that changed position."""
+    moved_rows = edit.rows[np.any(edit.new_coords != edit.old_coords, axis=1)]
+    segment = model.segments[edit.segment]
+    owners = np.searchsorted(segment.atom_start, moved_rows, side="right") - 1
+    return np.unique(owners)
+
+
+def test_locality_on_ubiquitin_doubles_per_level(model):
+    """Carson's ubiquitin experiment: 4 residues move at full resolution, 8, 16, 32 below."""
+    ribbon = model.ribbons[0]
+    counts = []
+    for level in (ribbon.max_level, 6, 5, 4):
+        points, _ = ribbon.control_points(level)
+        edit = model.move_point(0, level, len(points) // 2, [1.5, -1.0, 2.0])
+        residues = moved_residues(model, edit)
+        assert np.array_equal(residues, edit.residues)
+        assert np.all(np.diff(residues) == 1)  # one contiguous stretch
+        counts.append(len(residues))
+    assert counts == [4, 8, 16, 32]
+
+
+def test_unaffected_atoms_are_bit_identical(model, ubiquitin):
+    edit = model.move_point(0, 5, 9, [3.0, 0.0, -1.0])
+    model.apply(edit)
+    untouched = np.setdiff1d(np.arange(ubiquitin.n_atoms), edit.rows)
+    assert len(untouched) > 0.5 * ubiquitin.n_atoms
+    assert np.array_equal(model.coords[untouched], ubiquitin.coords[untouched])
+    assert not np.array_equal(model.coords[edit.rows], ubiquitin.coords[edit.rows])
+
+
+def test_residues_move_rigidly(model, ubiquitin):
+    edit = model.move_point(0, 3, 5, [4.0, 2.0, -3.0])
+    model.apply(edit)
+    segment = model.segments[0]
+    for residue in edit.residues:
+        rows = segment.atoms(residue)
+        before, after = ubiquitin.coords[rows], model.coords[rows]
+        distances = lambda a: np.linalg.norm(a[:, None] - a[None], axis=-1)  # noqa: E731
+        assert np.abs(distances(after) - distances(before)).max() < 1e-9
+
+
+def test_residue_points_follow_the_edited_curve(model):
+    edit = model.move_point(0, 4, 8, [2.0, 2.0, 2.0])
+    model.apply(edit)
+    ribbon = model.ribbons[0]
+    segment = model.segments[0]
+    # the Cα keeps its offset from C^r in the residue frame, so |Cα - C^r| is unchanged
+    ca_rows = [segment.atom_start[i] + 1 for i in edit.residues]  # atom order N, CA, ... in 1UBQ
+    before = np.linalg.norm(edit.old_coords[np.searchsorted(edit.rows, ca_rows)] - ribbon.space.evaluate(
+        edit.old_points, ribbon.residue_u[edit.residues]), axis=1)
+    after = np.linalg.norm(model.coords[ca_rows] - ribbon.residue_points()[edit.residues], axis=1)
+    assert np.allclose(before, after, atol=1e-9)
+
+
+def test_zero_edit_changes_nothing(model, ubiquitin):
+    edit = model.move_point(0, 3.5, 4, [0.0, 0.0, 0.0])
+    model.apply(edit)
+    assert len(edit.rows) == 0
+    assert np.array_equal(model.coords, ubiquitin.coords)
+
+
+def test_revert_restores_exactly_and_merged_edits_equal_the_sequence(model, ubiquitin):
+    first = model.move_point(0, 5, 10, [1.0, 0.0, 0.0])
+    model.apply(first)
+    second = model.tug(0, 4, float(model.ribbons[0].residue_u[30]), [0.0, 2.0, 0.0])
+    model.apply(second)
+    after_both = model.coords.copy()
+    points_after = model.ribbons[0].points.copy()
+    model.revert(second)
+    model.revert(first)
+    assert np.array_equal(model.coords, ubiquitin.coords)
+    merged = first.then(second)
+    model.apply(merged)
+    assert np.array_equal(model.coords, after_both)
+    assert np.array_equal(model.ribbons[0].points, points_after)
+    model.revert(merged)
+    assert np.array_equal(model.coords, ubiquitin.coords)
+
+
+def test_tugging_a_residue_moves_its_curve_point_by_the_displacement(model):
+    ribbon = model.ribbons[0]
+    residue = 40
+    u = float(ribbon.residue_u[residue])
+    before = ribbon.residue_points()[residue]
+    model.apply(model.tug(0, 4, u, [0.0, 0.0, 3.0]))
+    after = model.ribbons[0].residue_points()[residue]
+    assert np.allclose(after - before, [0.0, 0.0, 3.0], atol=1e-10)
+
+
+def test_saved_edit_reads_back(model, tmp_path):
+    edit = model.move_point(0, 4, 6, [2.0, -2.0, 1.0])
+    model.apply(edit)
+    for name in ("edited.pdb", "edited.cif"):
+        saved = model.save(tmp_path / name)
+        again = read_structure(saved)
+        assert np.allclose(again.coords, model.coords, atol=6e-4)
+    with pytest.raises(FileExistsError):
+        model.save(tmp_path / "edited.pdb")
+
+
+def test_every_segment_of_a_multichain_entry_is_editable():
+    structure = read_structure(DATA / "1TIM.pdb.gz")
+    model = EditableModel(structure, kind="calpha")
+    assert len(model.ribbons) == len(structure.segments) >= 2
+    edit = model.move_point(1, 3, 4, [1.0, 1.0, 1.0])
+    model.apply(edit)
+    chain_a_rows = np.concatenate([np.arange(a, b) for a, b in zip(model.segments[0].atom_start, model.segments[0].atom_stop)])
+    assert np.array_equal(model.coords[chain_a_rows], structure.coords[chain_a_rows])
+    with pytest.raises(ValueError, match="segment must be in"):
+        model.move_point(len(model.ribbons), 3, 0, [1.0, 0.0, 0.0])
+
+
+def test_fractional_edits_stay_local():
+    """The tails of a fractional-level edit below NEGLIGIBLE_MOVE move no residue."""
+    structure = read_structure(DATA / "1TIM.pdb.gz")
+    model = EditableModel(structure)
+    ribbon = model.ribbons[0]  # 247 residues, J = 8, maximum level 7.95
+    edit = model.move_point(0, 7.5, 60, [2.0, 0.0, 0.0])
+    assert 4 < len(edit.residues) < len(ribbon.residue_u) // 2
+    full = ribbon.residue_points()
+    moved_curve = ribbon.with_points(edit.new_points).residue_points()
+    still = np.setdiff1d(np.arange(len(full)), edit.residues)
+    assert np.abs(moved_curve[still] - full[still]).max() < 1e-5

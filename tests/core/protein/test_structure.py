@@ -1,0 +1,388 @@
+"""Reading real PDB/mmCIF entries into arrays and writing edited coordinates back."""
+
+from __future__ import annotations
+
+import gzip
+import time
+from pathlib import Path
+
+import gemmi
+import numpy as np
+import pytest
+
+from core.protein.reading import read_structure
+from core.protein.structure import (
+    MAX_CA_STEP,
+    SS_COMPUTED,
+    SS_FROM_MMCIF,
+    SS_FROM_PDB_RECORDS,
+    Structure,
+    StructureError,
+)
+from core.protein.writing import write_structure
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+PROTEINS = [
+    "1UBQ.pdb.gz", "1TIM.pdb.gz", "4YVS.cif.gz", "2K39_CA-only.pdb.gz", "1F9V.pdb.gz", "3JQH.cif.gz",
+    "1ORC.pdb.gz", "7Z9T.cif.gz", "4HHB.pdb.gz", "1L2Y.pdb.gz", "1BPI.pdb.gz",
+]  # fmt: skip
+
+
+def read(name: str) -> Structure:
+    return read_structure(DATA / name)
+
+
+def text_of(name: str) -> str:
+    return gzip.decompress((DATA / name).read_bytes()).decode()
+
+
+def record_lines(path: Path, record: str) -> list[str]:
+    opener = gzip.open if path.suffix == ".gz" else open
+    with opener(path, "rt") as handle:
+        return [line.rstrip() for line in handle if line[:6].strip() == record]
+
+
+# ----------------------------------------------------------------------------- reading
+
+
+def test_ubiquitin_is_one_segment_of_76_residues_with_records_ss() -> None:
+    s = read("1UBQ.pdb.gz")
+    assert (s.entry_id, s.source_format, s.n_residues, len(s.segments)) == ("1UBQ", "pdb", 76, 1)
+    seg = s.segments[0]
+    assert seg.chain == "A" and np.array_equal(seg.resseq, np.arange(1, 77))
+    assert np.isfinite(np.stack([seg.n, seg.ca, seg.c, seg.o])).all()
+    assert s.ss_source == SS_FROM_PDB_RECORDS
+    # HELIX records 23-34 (alpha) and 56-59 (3-10); SHEET strands 1-7, 10-17, 40-45, 48-49, 66-72.
+    assert np.array_equal(seg.resseq[seg.ss == "H"], np.r_[23:35, 56:60])
+    assert set(seg.resseq[seg.ss == "E"]) >= {1, 7, 10, 17, 40, 45, 48, 49, 66, 72}
+    assert s.n_water_atoms == 58 and s.n_hetero_atoms == 0
+    assert s.chains[0].name == "A" and s.chains[0].n_residues == 134 and s.chains[0].n_backbone == 76
+
+
+def test_triosephosphate_isomerase_has_two_chains() -> None:
+    s = read("1TIM.pdb.gz")
+    assert [(c.name, c.n_backbone, c.n_segments) for c in s.chains] == [("A", 247, 1), ("B", 247, 1)]
+    assert [seg.chain for seg in s.segments] == ["A", "B"]
+
+
+def test_mmcif_with_15_chains_reads_fast() -> None:
+    start = time.perf_counter()
+    s = read("4YVS.cif.gz")
+    elapsed = time.perf_counter() - start
+    assert s.source_format == "mmcif" and s.ss_source == SS_FROM_MMCIF
+    assert len(s.chains) == 15 and s.n_atoms == 26430
+    assert elapsed < 1.0
+
+
+def test_multi_character_chain_ids() -> None:
+    s = read("7Z9T.cif.gz")
+    assert [c.name for c in s.chains] == ["AAA", "BBB"]
+    assert {seg.chain for seg in s.segments} == {"AAA", "BBB"}
+    assert s.segments[0].labels[0].startswith("AAA:")
+
+
+@pytest.mark.parametrize("name", PROTEINS)
+def test_segments_never_jump_a_gap(name: str) -> None:
+    s = read(name)
+    for seg in s.segments:
+        assert len(seg) >= 2 and np.isfinite(seg.ca).all()
+        assert (np.linalg.norm(np.diff(seg.ca, axis=0), axis=1) <= MAX_CA_STEP).all()
+    for before, after in zip(s.segments[:-1], s.segments[1:], strict=True):
+        if before.chain == after.chain:
+            assert np.linalg.norm(after.ca[0] - before.ca[-1]) > MAX_CA_STEP
+
+
+def test_chain_with_missing_residues_is_split_at_each_gap() -> None:
+    s = read("1F9V.pdb.gz")
+    assert [seg.chain for seg in s.segments] == ["A"] * 5
+    assert [(seg.resseq[0], seg.resseq[-1]) for seg in s.segments] == [
+        (385, 532), (546, 582), (594, 612), (615, 667), (671, 726),
+    ]  # fmt: skip
+    assert s.n_residues == 313
+
+
+def test_insertion_codes_are_in_the_labels() -> None:
+    seg = read("1ORC.pdb.gz").segments[0]
+    assert [lab for lab, ic in zip(seg.labels, seg.icode, strict=True) if ic] == [
+        "A:ASP56A", "A:GLY56B", "A:GLU56C", "A:VAL56D", "A:LYS56E",
+    ]  # fmt: skip
+    assert seg.icode.dtype.kind == "U" and seg.icode[0] == ""
+
+
+def test_altlocs_all_atoms_kept_backbone_from_first_conformer() -> None:
+    s = read("3JQH.cif.gz")
+    st = gemmi.read_structure(str(DATA / "3JQH.cif.gz"))
+    assert s.n_atoms == st[0].count_atom_sites() == 238
+    assert s.n_altloc_atoms == sum(a.has_altloc() for ch in st[0] for r in ch for a in r) > 0
+    seg = s.segments[0]
+    # Residue 1 is PRO (altloc A, 7 atoms) or SER (altloc B, 6 atoms): one residue, 13 atoms.
+    assert seg.labels[0] == "A:PRO1" and seg.atoms(0) == slice(0, 13)
+    np.testing.assert_array_equal(seg.ca[0], [3.746, 20.507, 21.289])  # CA of conformer A
+    # LYS 3 has CA A and CA B in one residue: the backbone uses A.
+    lys3 = st[0]["A"]["3"][0]
+    np.testing.assert_array_equal(seg.ca[2], lys3.find_atom("CA", "A").pos.tolist())
+    assert np.array_equal(s.atom_residue[seg.atoms(2)], np.full(15, seg.residue_index[2]))
+    # Residue 15 has three residue-level conformers (ARG/GLN/GLU): one residue, 29 atoms.
+    k = seg.labels.index("A:ARG15")
+    assert seg.atom_stop[k] - seg.atom_start[k] == 29
+
+
+def test_ca_only_model() -> None:
+    s = read("2K39_CA-only.pdb.gz")
+    seg = s.segments[0]
+    assert len(s.segments) == 1 and len(seg) == 76 and s.n_atoms == 76
+    assert np.isfinite(seg.ca).all()
+    assert np.isnan(np.stack([seg.n, seg.c, seg.o])).all()
+
+
+def test_nmr_entry_uses_the_first_model_only() -> None:
+    s = read("1L2Y.pdb.gz")
+    assert s.n_models == 38 and s.n_atoms == 304 and s.n_residues == 20
+    first_atom = next(line for line in text_of("1L2Y.pdb.gz").splitlines() if line.startswith("ATOM"))
+    expected = [float(first_atom[30:38]), float(first_atom[38:46]), float(first_atom[46:54])]
+    np.testing.assert_array_equal(s.coords[0], expected)
+
+
+def test_dna_only_entry_has_no_protein_chain() -> None:
+    with pytest.raises(StructureError, match=r"1BNA\.pdb\.gz: no protein chain"):
+        read("1BNA.pdb.gz")
+
+
+@pytest.mark.parametrize("name", ["1UBQ.pdb.gz", "3JQH.cif.gz", "4HHB.pdb.gz"])
+def test_atom_residue_matches_segment_atom_ranges(name: str) -> None:
+    s = read(name)
+    expected = np.full(s.n_atoms, -1)
+    for seg in s.segments:
+        assert np.array_equal(
+            seg.residue_index, np.arange(seg.residue_index[0], seg.residue_index[0] + len(seg))
+        )
+        for i in range(len(seg)):
+            rows = s.coords[seg.atoms(i)]
+            assert (np.abs(rows - seg.ca[i]).sum(axis=1) == 0).any()  # the Cα is one of its atoms
+            expected[seg.atoms(i)] = seg.residue_index[i]
+    assert np.array_equal(s.atom_residue, expected)
+    assert (s.atom_residue == -1).sum() >= s.n_water_atoms + s.n_hetero_atoms
+
+
+def test_arrays_are_read_only() -> None:
+    s = read("1UBQ.pdb.gz")
+    with pytest.raises(ValueError):
+        s.coords[0, 0] = 0.0
+    with pytest.raises(ValueError):
+        s.segments[0].ca[0, 0] = 0.0
+
+
+def test_residue_without_ca_is_skipped_with_a_warning(tmp_path: Path) -> None:
+    lines = text_of("1UBQ.pdb.gz").splitlines()
+    no_ca = [
+        ln for ln in lines if not (ln.startswith("ATOM") and ln[12:16] == " CA " and ln[22:26] == "  40")
+    ]
+    path = tmp_path / "no_ca.pdb"
+    path.write_text("\n".join(no_ca) + "\n")
+    s = read_structure(path)
+    assert [(seg.resseq[0], seg.resseq[-1]) for seg in s.segments] == [(1, 39), (41, 76)]
+    assert any("A:GLN40" in w and "no CA" in w for w in s.warnings)
+
+
+def test_single_residue_segment_is_dropped_with_a_warning(tmp_path: Path) -> None:
+    lines = text_of("1UBQ.pdb.gz").splitlines()
+    keep = [ln for ln in lines if not (ln.startswith("ATOM") and ln[22:26] in ("  39", "  41"))]
+    path = tmp_path / "lonely.pdb"
+    path.write_text("\n".join(keep) + "\n")
+    s = read_structure(path)
+    assert [(seg.resseq[0], seg.resseq[-1]) for seg in s.segments] == [(1, 38), (42, 76)]
+    assert any("A:GLN40" in w for w in s.warnings)
+    pro40 = [ln for ln in keep if ln.startswith("ATOM") and ln[22:26] == "  40"]
+    assert (s.atom_residue == -1).sum() == len(pro40) + s.n_water_atoms
+
+
+def test_bare_atom_records_without_header(tmp_path: Path) -> None:
+    lines = text_of("1UBQ.pdb.gz").splitlines()
+    path = tmp_path / "bare.pdb"
+    path.write_text("\n".join(ln for ln in lines if ln.startswith(("ATOM", "HETATM"))) + "\n")
+    s = read_structure(path)
+    assert (s.entry_id, s.n_residues, len(s.segments), s.n_water_atoms) == ("bare", 76, 1, 58)
+    assert s.ss_source == SS_COMPUTED
+
+
+def test_secondary_structure_is_computed_without_records(tmp_path: Path) -> None:
+    lines = text_of("1UBQ.pdb.gz").splitlines()
+    path = tmp_path / "no_records.pdb"
+    path.write_text("\n".join(ln for ln in lines if not ln.startswith(("HELIX", "SHEET"))) + "\n")
+    s = read_structure(path)
+    seg = s.segments[0]
+    assert s.ss_source == SS_COMPUTED
+    assert (seg.ss[(seg.resseq >= 24) & (seg.resseq <= 33)] == "H").all()
+    assert (seg.ss[(seg.resseq >= 2) & (seg.resseq <= 7)] == "E").all()
+
+
+def test_bad_inputs_raise_one_clear_error(tmp_path: Path) -> None:
+    empty = tmp_path / "empty.pdb"
+    empty.write_bytes(b"")
+    text = tmp_path / "notes.pdb"
+    text.write_text("hello\nthis is not a structure\n")
+    nan = tmp_path / "nan.pdb"
+    nan.write_text("ATOM      1  CA  GLY A   1         nan   1.000   2.000  1.00  0.00           C\n")
+    corrupt = tmp_path / "corrupt.cif.gz"
+    corrupt.write_bytes(b"\x1f\x8b\x08\x00garbage")
+    cases = {
+        tmp_path / "missing.pdb": "no such file",
+        empty: "empty file",
+        text: "not a structure file",
+        nan: "non-finite coordinates",
+        corrupt: "corrupt gzip",
+        tmp_path: "is a directory",
+    }
+    for path, problem in cases.items():
+        with pytest.raises(StructureError) as info:
+            read_structure(path)
+        message = str(info.value)
+        assert message.startswith(str(path)) and problem in message and "\n" not in message
+
+
+# ----------------------------------------------------------------------------- writing
+
+
+ROUND_TRIPS = [
+    ("1BPI.pdb.gz", ".pdb"), ("1BPI.pdb.gz", ".cif.gz"), ("4HHB.pdb.gz", ".ent.gz"),
+    ("4HHB.pdb.gz", ".mmcif"), ("3JQH.cif.gz", ".cif"), ("3JQH.cif.gz", ".pdb.gz"),
+    ("7Z9T.cif.gz", ".cif"), ("1L2Y.pdb.gz", ".pdb"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("name", "suffix"), ROUND_TRIPS)
+def test_round_trip_without_edit(tmp_path: Path, name: str, suffix: str) -> None:
+    s = read(name)
+    out = write_structure(s, s.coords, tmp_path / f"out{suffix}")
+    t = read_structure(out)
+    np.testing.assert_allclose(t.coords, s.coords, atol=5e-4, rtol=0)
+    for attr in (
+        "n_atoms",
+        "n_hetero_atoms",
+        "n_water_atoms",
+        "n_altloc_atoms",
+        "n_models",
+        "n_residues",
+    ):
+        assert getattr(t, attr) == getattr(s, attr), attr
+    assert [c.name for c in t.chains] == [c.name for c in s.chains]
+    for a, b in zip(s.segments, t.segments, strict=True):
+        assert a.labels == b.labels and np.array_equal(a.ss, b.ss)
+
+
+def test_pdb_output_keeps_the_header_records(tmp_path: Path) -> None:
+    source = DATA / "1BPI.pdb.gz"
+    s = read_structure(source)
+    out = write_structure(s, s.coords, tmp_path / "1bpi.pdb")
+    for record in (
+        "SEQRES",
+        "SHEET",
+        "SSBOND",
+        "HETATM",
+        "CONECT",
+        "CRYST1",
+        "COMPND",
+        "SOURCE",
+        "AUTHOR",
+        "JRNL",
+    ):
+        assert record_lines(out, record) == record_lines(source, record) != [], record
+    # gemmi renumbers helix ids; the ranges and classes are kept.
+    assert [ln[14:] for ln in record_lines(out, "HELIX")] == [
+        ln[14:] for ln in record_lines(source, "HELIX")
+    ]
+    assert len(record_lines(out, "REMARK")) == len(record_lines(source, "REMARK"))
+    assert read_structure(out).title == s.title
+
+
+def test_mmcif_output_keeps_every_category_and_author_numbering(tmp_path: Path) -> None:
+    s = read("7Z9T.cif.gz")
+    out = write_structure(s, s.coords, tmp_path / "7z9t.cif")
+    before = gemmi.cif.read(str(DATA / "7Z9T.cif.gz")).sole_block()
+    after = gemmi.cif.read(str(out)).sole_block()
+    assert after.get_mmcif_category_names() == before.get_mmcif_category_names()
+    for tag in ("auth_seq_id", "auth_asym_id", "label_seq_id", "label_alt_id", "pdbx_PDB_ins_code"):
+        assert list(after.find_values(f"_atom_site.{tag}")) == list(
+            before.find_values(f"_atom_site.{tag}")
+        ), tag
+    for tag in ("B_iso_or_equiv", "occupancy"):
+        values = [
+            np.array(block.find_values(f"_atom_site.{tag}"), dtype=float) for block in (before, after)
+        ]
+        np.testing.assert_array_equal(*values)
+    assert list(after.find_values("_struct_conn.id")) == list(before.find_values("_struct_conn.id"))
+
+
+@pytest.mark.parametrize("suffix", [".pdb", ".cif"])
+def test_moved_subset_is_written_and_others_unchanged(tmp_path: Path, suffix: str) -> None:
+    s = read("1UBQ.pdb.gz")
+    seg = s.segments[0]
+    moved = np.isin(s.atom_residue, seg.residue_index[9:20])
+    angle = 0.3
+    rotation = np.array(
+        [[np.cos(angle), -np.sin(angle), 0], [np.sin(angle), np.cos(angle), 0], [0, 0, 1]]
+    )
+    coords = s.coords.copy()
+    coords[moved] = (coords[moved] - seg.ca[14]) @ rotation.T + seg.ca[14] + [1.23456, -2.5, 0.75]
+    t = read_structure(write_structure(s, coords, tmp_path / f"moved{suffix}"))
+    np.testing.assert_allclose(t.coords[moved], np.round(coords[moved], 3), atol=1e-9, rtol=0)
+    np.testing.assert_array_equal(t.coords[~moved], s.coords[~moved])
+    assert moved.sum() == 81
+
+
+def test_other_models_are_written_unchanged(tmp_path: Path) -> None:
+    s = read("1L2Y.pdb.gz")
+    out = write_structure(s, s.coords + 1.0, tmp_path / "nmr.pdb")
+    st_in, st_out = (gemmi.read_structure(str(p)) for p in (DATA / "1L2Y.pdb.gz", out))
+    assert len(st_out) == 38
+    first_in, first_out = (
+        np.array([cra.atom.pos.tolist() for cra in m.all()]) for m in (st_in[0], st_out[0])
+    )
+    np.testing.assert_allclose(first_out, first_in + 1.0, atol=1e-9)
+    second_in, second_out = (
+        np.array([cra.atom.pos.tolist() for cra in m.all()]) for m in (st_in[1], st_out[1])
+    )
+    np.testing.assert_array_equal(second_out, second_in)
+
+
+def test_existing_files_and_the_input_are_not_overwritten(tmp_path: Path) -> None:
+    source = tmp_path / "1ubq.pdb"
+    source.write_bytes(gzip.decompress((DATA / "1UBQ.pdb.gz").read_bytes()))
+    original = source.read_bytes()
+    s = read_structure(source)
+    with pytest.raises(FileExistsError, match="input file"):
+        write_structure(s, s.coords + 1.0, source)
+    assert source.read_bytes() == original
+    target = tmp_path / "edit.pdb"
+    target.write_text("precious\n")
+    with pytest.raises(FileExistsError, match="existing file"):
+        write_structure(s, s.coords, target)
+    assert target.read_text() == "precious\n"
+    write_structure(s, s.coords + 1.0, target, overwrite=True)
+    np.testing.assert_allclose(read_structure(target).coords, s.coords + 1.0, atol=5e-4)
+    write_structure(s, s.coords + 2.0, source, overwrite=True)
+    np.testing.assert_allclose(read_structure(source).coords, s.coords + 2.0, atol=5e-4)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "1ubq.pdb",
+        "edit.pdb",
+    ]  # no temporary files left
+
+
+def test_failed_write_leaves_nothing_behind(tmp_path: Path) -> None:
+    s = read("7Z9T.cif.gz")
+    with pytest.raises(StructureError, match="chain name too long"):
+        write_structure(s, s.coords, tmp_path / "7z9t.pdb")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_write_rejects_bad_arguments(tmp_path: Path) -> None:
+    s = read("1UBQ.pdb.gz")
+    with pytest.raises(StructureError, match=r"shape \(660, 3\)"):
+        write_structure(s, s.coords[:-1], tmp_path / "a.pdb")
+    bad = s.coords.copy()
+    bad[3, 1] = np.nan
+    with pytest.raises(StructureError, match="non-finite"):
+        write_structure(s, bad, tmp_path / "a.pdb")
+    with pytest.raises(StructureError, match="unknown extension"):
+        write_structure(s, s.coords, tmp_path / "a.xyz")
+    assert list(tmp_path.iterdir()) == []
