@@ -6,6 +6,9 @@ from pathlib import Path
 # pyvistaqt reaches Qt through qtpy; pin qtpy to PySide6 before any app module imports it.
 os.environ.setdefault("QT_API", "pyside6")
 
+PROG = "ribbonwave"
+"""The name of the command."""
+
 EXAMPLES_DIR = Path(__file__).resolve().parent.parent / "resources" / "examples"
 """Bundled example structures (resources/ sits beside this package; install editable)."""
 

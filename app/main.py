@@ -16,9 +16,9 @@ import sys
 from collections.abc import Sequence
 from typing import NamedTuple
 
+from app import PROG
 from app.errors import InputError
 
-PROG = "ribbonwave"
 DEFAULT_COMMAND = "open"
 VECTOR_OPTIONS = ("--move",)
 """Options whose value is a comma-separated vector that may start with a minus sign."""

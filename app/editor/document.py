@@ -15,15 +15,16 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-from PySide6.QtCore import QObject, Signal
+from PySide6.QtCore import QObject, QSignalBlocker, Signal
 from PySide6.QtGui import QUndoStack
 
+from app.editor import records
 from app.editor.commands import EditCommand
 from app.editor.scene.curves import LevelCurve, SegmentPath
 from app.editor.scene.molecule import ca_rows
 from core.geometry.regularize import FLANK, regularize_region, regularized
 from core.protein.model import Edit, EditableModel
-from core.protein.reading import read_structure
+from core.protein.reading import read_bytes, read_structure
 from core.protein.ribbon import RibbonKind
 from core.protein.structure import Structure
 
@@ -74,6 +75,10 @@ class Document(QObject):
         self.ca_rows = np.empty(0, dtype=np.int64)
         """Row of the coordinates holding each backbone residue's Cα (residue-table order)."""
         self.path: Path | None = None
+        self.source = b""
+        """The file's bytes as read (journals and sessions embed them)."""
+        self.replaying = False
+        """Whether :meth:`replay` is rebuilding the history (its steps are not new)."""
         self.save_path: Path | None = None
         """Where Save writes without asking; None until Save As chose a file."""
         self.segment = 0
@@ -147,10 +152,13 @@ class Document(QObject):
 
     # ------------------------------------------------------------------ mutators
 
-    def open(self, path: Path, kind: RibbonKind | str = RibbonKind.PEPTIDE) -> None:
-        """Read ``path`` and make it the document (raises :class:`core.protein.structure.StructureError`)."""
-        self._set_model(EditableModel(read_structure(path), kind))
+    def open(self, path: Path, kind: RibbonKind | str = RibbonKind.PEPTIDE, data: bytes | None = None) -> None:
+        """Read ``path`` (or its content ``data``, already read) and make it the document
+        (raises :class:`core.protein.structure.StructureError`)."""
+        data = read_bytes(path) if data is None else data
+        self._set_model(EditableModel(read_structure(path, data), kind))
         self.path = Path(path)
+        self.source = data
         self.save_path = None
         self.fileChanged.emit()
 
@@ -255,6 +263,64 @@ class Document(QObject):
         self.undo_stack.setClean()
         self.fileChanged.emit()
         return written
+
+    # ------------------------------------------------------------------ recordings
+
+    def state(self) -> dict:
+        """The stack position, the clean position, the file names, level, segment and
+        multiresolution switch (the fields of an ``index`` record)."""
+        return {"index": self.undo_stack.index(), "clean": self.undo_stack.cleanIndex(),
+                "path": str(self.path), "save_path": None if self.save_path is None else str(self.save_path),
+                "level": self.level, "segment": self.segment, "multiresolution": self.multiresolution}
+
+    def recording(self) -> list[records.Record]:
+        """The document as records: the file as read, every undo step, the current state."""
+        stack = self.undo_stack
+        steps = [records.push(k, stack.text(k), stack.command(k).edit) for k in range(stack.count())]
+        return [records.header(self.path, self.kind.value, self.source), *steps, records.Record("index", self.state())]
+
+    def replay(self, recording: list[records.Record]) -> None:
+        """Make the document what ``recording`` (:meth:`recording`, or a journal) describes:
+        the file as read, the same undo history at the same position, bit for bit. Views
+        are told once, at the end. Raises StructureError for an unreadable embedded file."""
+        head, files, view = recording[0].fields, None, None
+        self.replaying = True
+        try:
+            with QSignalBlocker(self):
+                self.open(Path(head["path"]), head["kind"], records.source_of(recording[0]))
+                stack = self.undo_stack
+                for record in recording[1:]:
+                    if record.kind == "push":
+                        stack.setIndex(record.fields["at"])
+                        stack.push(EditCommand(self, records.edit_of(record), record.fields["text"]))
+                    elif record.kind == "index":
+                        stack.setIndex(record.fields["index"])
+                        files = view = record.fields
+                    elif record.kind == "state":
+                        view = record.fields
+                if files is not None:
+                    self._restore_files(files)
+                if view is not None:
+                    self.segment = min(int(view["segment"]), len(self._model.ribbons) - 1)
+                    self.multiresolution = bool(view["multiresolution"])
+                    self.level = float(np.clip(view["level"], 0.0, self.max_level))
+        finally:
+            self.replaying = False
+        for signal in (self.loaded, self.segmentChanged, self.levelChanged, self.fileChanged):
+            signal.emit()
+
+    def _restore_files(self, state: dict) -> None:
+        """The clean position and the file names of an ``index`` record."""
+        stack = self.undo_stack
+        index = stack.index()
+        if state["clean"] >= 0:
+            stack.setIndex(state["clean"])
+            stack.setClean()
+        else:
+            stack.resetClean()
+        stack.setIndex(index)
+        self.path = Path(state["path"])
+        self.save_path = None if state["save_path"] is None else Path(state["save_path"])
 
     # ------------------------------------------------------------------ internals
 

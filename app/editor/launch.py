@@ -4,15 +4,22 @@ The arguments are declared without Qt; Qt and VTK load only when the window open
 headless commands start fast.
 """
 
+from __future__ import annotations
+
 import argparse
 import os
 import signal
 import sys
+import traceback
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from app import DEFAULT_STRUCTURE
+from app import DEFAULT_STRUCTURE, PROG
 from app.errors import InputError
 from core.protein.structure import StructureError
+
+if TYPE_CHECKING:
+    from app.editor.main_window import MainWindow
 
 
 def open_arguments(parser: argparse.ArgumentParser) -> None:
@@ -22,7 +29,20 @@ def open_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         default=DEFAULT_STRUCTURE,
         metavar="FILE",
-        help="structure file (PDB or mmCIF, optionally gzipped); default: the bundled 1UBQ.pdb",
+        help="structure file (PDB or mmCIF, optionally gzipped) or session (.rwsession); "
+        "default: the bundled 1UBQ.pdb",
+    )
+    parser.add_argument(
+        "--recover",
+        action="store_true",
+        help="restore the unsaved edits of the last editor that did not close cleanly (FILE is not read)",
+    )
+    parser.add_argument(
+        "--script",
+        type=Path,
+        metavar="SCRIPT.py",
+        help="run a Python script in the editor, with the object rw (see the README), after FILE is "
+        "loaded; then exit (unsaved edits stay in the recovery journal)",
     )
     parser.add_argument(
         "--screenshot",
@@ -63,28 +83,77 @@ def run_open(args: argparse.Namespace) -> int:
     # Qt and VTK load only for the window, so commands without one start fast.
     from PySide6.QtWidgets import QApplication
 
-    from app.editor.document import Document
     from app.editor.main_window import MainWindow
-    from app.editor.scene.scene import Layer
 
     if args.level is not None and not args.level >= 0:
         raise InputError(f"--level must be >= 0; got {args.level:g}")
     if sys.platform.startswith("linux") and not any(map(os.environ.get, ("DISPLAY", "WAYLAND_DISPLAY",
                                                                          "QT_QPA_PLATFORM"))):
         raise InputError("no display to open a window on; run under xvfb-run (scripts/ribbonwave.sh does)")
+    script = _read_script(args.script) if args.script is not None else None
     app = QApplication.instance() or QApplication(sys.argv[:1])
-    document = Document()
+    window = MainWindow()
+    window.unattended = script is not None or args.screenshot is not None
     try:
-        document.open(args.file, args.ribbon)
-    except StructureError as error:
-        raise InputError(str(error)) from error
+        _load(window, args)
+    except InputError:
+        window.close()
+        raise
+    window.show()
+    if not window.unattended and not args.recover:
+        window.offer_recovery()
+    status = 0
+    if script is not None:
+        app.processEvents()  # the window laid out, as a person would first see it
+        status = _run_script(window, args.script, script)
+    if window.isVisible() and args.screenshot is not None:
+        app.processEvents()  # lay the window out before it is grabbed
+        try:
+            window.save_screenshot(args.screenshot)
+        except OSError as error:
+            window.close()
+            raise InputError(str(error)) from error
+    if window.unattended:
+        window.close()
+        kept = window.journal.kept
+        if kept is not None:
+            print(f"{PROG}: unsaved edits are kept in {kept}; `{PROG} --recover` restores them", file=sys.stderr)
+        return status
+    signal.signal(signal.SIGINT, signal.SIG_DFL)  # let Ctrl+C in the terminal end the event loop
+    return app.exec()
+
+
+def _load(window: MainWindow, args: argparse.Namespace) -> None:
+    """Open what the arguments name in ``window``: the most recent journal left by a crash,
+    a session or a structure, then the level, hidden layers and compared structures."""
+    from app.editor import journal, records
+    from app.editor.scene.scene import Layer
+    from app.editor.session import SUFFIX as SESSION_SUFFIX, SessionError
+
+    if args.recover:
+        left = journal.orphans(window.journal.folder)
+        if not left:
+            raise InputError(f"nothing to recover: no journal of an editor that did not close cleanly in "
+                             f"{window.journal.folder}")
+        try:
+            print(f"{PROG}: {window.restore_journal(left[0])}", file=sys.stderr)
+        except (OSError, records.RecordError, StructureError) as error:
+            raise InputError(f"{left[0]}: cannot restore ({error})") from error
+    elif args.file.name.endswith(SESSION_SUFFIX):
+        try:
+            window.open_session(args.file, raise_errors=True)
+        except SessionError as error:
+            raise InputError(str(error)) from error
+    else:
+        try:
+            window.document.open(args.file, args.ribbon)
+        except StructureError as error:
+            raise InputError(str(error)) from error
     if args.level is not None:
-        document.set_level(args.level)
-    window = MainWindow(document)
+        window.document.set_level(args.level)
     for name in args.hide:
         layer = Layer.__members__.get(name.upper().replace("-", "_"))
         if layer is None:
-            window.close()
             names = ", ".join(member.lower().replace("_", "-") for member in Layer.__members__)
             raise InputError(f"--hide: no layer {name!r}; layers: {names}")
         window.display_panel.layer_boxes[layer].setChecked(False)
@@ -93,21 +162,32 @@ def run_open(args: argparse.Namespace) -> int:
         try:
             window.comparison.add(path, chain)
         except (StructureError, ValueError) as error:
-            window.close()
             raise InputError(f"--compare {spec}: {error}") from error
     if args.compare:
         window.comparison_panel.parentWidget().raise_()  # the dock listing them in front of its tab group
-    window.show()
-    if args.screenshot is None:
-        signal.signal(signal.SIGINT, signal.SIG_DFL)  # let Ctrl+C in the terminal end the event loop
-        return app.exec()
-    app.processEvents()  # lay the window out before it is grabbed
+
+
+def _read_script(path: Path) -> str:
     try:
-        window.save_screenshot(args.screenshot)
-    except OSError as error:
-        raise InputError(str(error)) from error
-    finally:
-        window.close()
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise InputError(f"--script {path}: cannot read ({getattr(error, 'strerror', None) or error})") from None
+
+
+def _run_script(window: MainWindow, path: Path, text: str) -> int:
+    """Run ``text`` (the script at ``path``) with ``rw``; an exception prints the script's
+    traceback and gives exit status 1, ``sys.exit(n)`` gives ``n``."""
+    namespace = {"__name__": "__main__", "__file__": str(path), "rw": window.rw}
+    try:
+        exec(compile(text, str(path), "exec"), namespace)  # noqa: S102 (running the user's script is the point)
+    except SystemExit as error:
+        return error.code if isinstance(error.code, int) else (0 if error.code is None else 1)
+    except BaseException as error:  # noqa: BLE001 (any failure of the script is reported, not raised)
+        tb = error.__traceback__
+        while tb is not None and tb.tb_frame.f_code.co_filename != str(path):
+            tb = tb.tb_next  # from the script's own frames on
+        traceback.print_exception(type(error), error, tb)
+        return 1
     return 0
 
 

@@ -10,6 +10,7 @@ would be lost. The ``app`` package sets ``QT_API`` before this module imports py
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -41,7 +42,9 @@ from PySide6.QtWidgets import (
 from pyvistaqt import QtInteractor
 
 from app import EXAMPLES_DIR
+from app.editor import journal, records, session
 from app.editor.docks.comparison import ComparisonPanel
+from app.editor.docks.console import PythonConsole
 from app.editor.docks.panels import DisplayPanel, RibbonDimensionPanel
 from app.editor.docks.surfaces import SurfaceLayer, SurfacePanel
 from app.editor.docks.validation import ValidationPanel
@@ -49,9 +52,11 @@ from app.editor.document import Document
 from app.editor.drag import DragController, Mode, PointerEvent
 from app.editor.live_validation import LiveValidation
 from app.editor.picking import PRIORITY, PointerAdapter
+from app.editor.scene.molecule import Colouring
 from app.editor.scene.overlay import Comparison, ComparisonView
 from app.editor.scene.scene import Layer, Scene
 from app.editor.scene.validation_markers import ValidationMarkers
+from app.editor.scripting import EditorAPI
 from core.protein.structure import StructureError
 
 APP_NAME = "ribbonwave"
@@ -60,6 +65,7 @@ MAX_RECENT = 8
 STRUCTURE_FILTER = "Structures (*.pdb *.ent *.cif *.mmcif *.gz);;All files (*)"
 SAVE_FILTERS = {"PDB (*.pdb *.pdb.gz *.ent)": ".pdb", "mmCIF (*.cif *.cif.gz *.mmcif)": ".cif"}
 SAVE_SUFFIXES = (".pdb", ".ent", ".cif", ".mmcif", ".pdb.gz", ".ent.gz", ".cif.gz", ".mmcif.gz")
+SESSION_FILTER = f"ribbonwave sessions (*{session.SUFFIX});;All files (*)"
 
 
 class MainWindow(QMainWindow):
@@ -72,6 +78,9 @@ class MainWindow(QMainWindow):
         self.settings = QSettings(APP_NAME, APP_NAME)
         self.resize(1400, 900)
         self.setAcceptDrops(True)
+        self.unattended = False
+        """Run by a script: no dialog waits for a person, and unsaved edits stay in the journal."""
+        self.journal = journal.Journal(self.document)
 
         self.plotter = QtInteractor(self, auto_update=False)
         self.plotter.setAcceptDrops(False)  # dropped files go to the window, which opens them
@@ -96,11 +105,16 @@ class MainWindow(QMainWindow):
         self.surface_panel = SurfacePanel(self.surface_layer)
         self.history = QUndoView(self.document.undo_stack)
         self.history.setEmptyLabel("<structure as read>")
+        self.rw = EditorAPI(self)
+        """The ``rw`` object of scripts and of the Python console."""
+        self.console = PythonConsole({"rw": self.rw, "np": np})
         docks = [self._dock("Ribbon dimension", self.dimension_panel),
                  self._dock("Display", _scrolled(self.display_panel)),
                  self._dock("Undo history", self.history), self._dock("Validation", _scrolled(self.validation_panel)),
                  self._dock("Compared structures", self.comparison_panel)]
         docks.append(self._dock("Surface", self.surface_panel))
+        self.console_dock = self._dock("Python Console", self.console)
+        self.console_dock.hide()
         self.tabifyDockWidget(docks[1], docks[-1])  # beside the ribbon's display options
         docks[1].raise_()
         self.tabifyDockWidget(docks[2], docks[3])  # validation and history share a place: the window stays small
@@ -108,6 +122,7 @@ class MainWindow(QMainWindow):
         docks[3].raise_()
         self._create_actions()
         self._create_menus(docks)
+        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.console_dock)
         self._create_status_bar()
 
         self.document.fileChanged.connect(self._update_title)
@@ -121,17 +136,111 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ files
 
-    def open_file(self, path: Path) -> bool:
-        """Open ``path`` after asking about unsaved edits; a bad file is reported in a dialog."""
+    def open_file(self, path: Path, *, raise_errors: bool = False) -> bool:
+        """Open ``path`` after asking about unsaved edits; a bad file is reported in a dialog
+        (or raised as StructureError with ``raise_errors``)."""
         if not self.maybe_save():
             return False
         try:
             self.document.open(Path(path))
         except StructureError as error:
+            if raise_errors:
+                raise
             QMessageBox.critical(self, APP_NAME, str(error))
             return False
         self._add_recent(Path(path))
         return True
+
+    def open_session(self, path: Path, *, raise_errors: bool = False) -> bool:
+        """Open a session file after asking about unsaved edits: the structure, the undo history at
+        its position, the view and the compared structures (errors as for :meth:`open_file`,
+        raised as SessionError)."""
+        if not self.maybe_save():
+            return False
+        try:
+            recording, view = session.read(Path(path))
+            self._replay(recording)
+        except (session.SessionError, StructureError) as error:
+            if raise_errors:
+                raise session.SessionError(str(error)) from None
+            QMessageBox.critical(self, APP_NAME, str(error))
+            return False
+        self._apply_view(view)
+        self._add_recent(Path(path))
+        return True
+
+    def write_session(self, path: Path) -> Path:
+        """Save the session to ``path`` (``.rwsession`` added if missing); raises OSError."""
+        if self.document.model is None:
+            raise RuntimeError("no structure is open")
+        path = Path(path) if Path(path).name.endswith(session.SUFFIX) else Path(f"{path}{session.SUFFIX}")
+        session.write(path, self.document.recording(), self._view())
+        return path
+
+    def save_session(self) -> bool:
+        """Ask for a file name and save the session there."""
+        if self.document.model is None:
+            return False
+        source = self.document.path
+        folder = Path.home() if source is None or source.parent == EXAMPLES_DIR else source.parent
+        stem = source.name.split(".")[0] if source is not None else "session"
+        name, _ = QFileDialog.getSaveFileName(self, "Save Session", str(folder / f"{stem}{session.SUFFIX}"),
+                                              SESSION_FILTER)
+        if not name:
+            return False
+        try:
+            self.write_session(Path(name))
+        except OSError as error:
+            QMessageBox.critical(self, APP_NAME, f"cannot write {name}: {error.strerror or error}")
+            return False
+        return True
+
+    def restore_journal(self, path: Path) -> str:
+        """Restore the document a crashed editor journalled at ``path``; returns what was
+        restored (raises OSError, RecordError or StructureError)."""
+        recording, damaged = records.read(Path(path))
+        self._replay(recording)
+        Path(path).unlink(missing_ok=True)
+        stack = self.document.undo_stack
+        message = f"restored {stack.count()} undo step(s) of {self.document.path.name}, {stack.index()} done"
+        if damaged:
+            message += "; the journal was cut off after them (the step in progress at the crash is lost)"
+        self.statusBar().showMessage(message, 15000)
+        return message
+
+    def offer_recovery(self) -> None:
+        """If an editor ended without closing cleanly, offer to restore its unsaved edits."""
+        left = journal.orphans(self.journal.folder)
+        if not left:
+            return
+        buttons = QMessageBox.StandardButton
+        answer = QMessageBox.question(
+            self, APP_NAME, "ribbonwave did not close cleanly last time. Restore the unsaved edits "
+            f"({time_label(left[0])})? Discard deletes them; Ignore keeps them for later.",
+            buttons.Yes | buttons.Discard | buttons.Ignore)
+        if answer == buttons.Yes:
+            try:
+                self.restore_journal(left[0])
+            except (OSError, records.RecordError, StructureError) as error:
+                QMessageBox.critical(self, APP_NAME, f"cannot restore {left[0].name}: {error}")
+        elif answer == buttons.Discard:
+            left[0].unlink(missing_ok=True)
+
+    def export_view(self, path: Path, width: int | None = None, height: int | None = None) -> Path:
+        """Save the 3D view as a PNG image of ``width`` x ``height`` pixels (default: the view's)."""
+        size = None if width is None and height is None else (width or self.plotter.width(),
+                                                               height or self.plotter.height())
+        self.plotter.renderer.SetUseFXAA(True)
+        self.plotter.screenshot(str(path), window_size=size)
+        return Path(path)
+
+    def quit_unattended(self, discard: bool = False) -> None:
+        """Close without asking: unsaved edits are kept in the journal unless ``discard``."""
+        self.unattended = True
+        if discard:
+            self.journal.discard()
+            self.document.undo_stack.setClean()
+        self.close()
 
     def save(self) -> bool:
         """Save to the file chosen by the last Save As; the first Save of a file asks where."""
@@ -181,8 +290,14 @@ class MainWindow(QMainWindow):
         return [value] if isinstance(value, str) else list(value or [])
 
     def maybe_save(self) -> bool:
-        """True when it is fine to drop the document: no unsaved edits, saved, or discarded."""
+        """True when it is fine to drop the document: no unsaved edits, saved, or discarded
+        (unattended, the edits stay in the journal). The journal of a document dropped
+        without unsaved edits is deleted."""
         if not self.document.modified:
+            self.journal.discard()
+            return True
+        if self.unattended:
+            self.journal.keep()
             return True
         name = self.document.path.name if self.document.path else "the structure"
         answer = QMessageBox.question(
@@ -190,8 +305,14 @@ class MainWindow(QMainWindow):
             QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel,
         )
         if answer == QMessageBox.StandardButton.Save:
-            return self.save()
-        return answer == QMessageBox.StandardButton.Discard
+            saved = self.save()
+            if saved:
+                self.journal.discard()
+            return saved
+        if answer == QMessageBox.StandardButton.Discard:
+            self.journal.discard()
+            return True
+        return False
 
     def save_screenshot(self, path: Path) -> None:
         """Render the window, 3D view included, to a PNG image (raises OSError)."""
@@ -215,6 +336,7 @@ class MainWindow(QMainWindow):
         if not self.maybe_save():
             event.ignore()
             return
+        self.journal.stop()  # deleted by maybe_save unless it holds unsaved edits
         self.surface_layer.shutdown()
         self.pointer.close()
         self.plotter.close()
@@ -248,6 +370,9 @@ class MainWindow(QMainWindow):
         self.save_action = self._action("&Save", QKeySequence.StandardKey.Save, self.save,
                                         icon(pixmap.SP_DialogSaveButton))
         self.save_as_action = self._action("Save &As…", QKeySequence.StandardKey.SaveAs, self.save_as)
+        self.open_session_action = self._action("Open Sess&ion…", QKeySequence("Ctrl+Shift+O"),
+                                                self._open_session_dialog)
+        self.save_session_action = self._action("Save Sessio&n…", QKeySequence("Ctrl+Alt+S"), self.save_session)
         self.export_action = self._action("&Export Image…", QKeySequence("Ctrl+E"), lambda: self.export_image())
         self.quit_action = self._action("&Quit", QKeySequence.StandardKey.Quit, self.close)
         stack = self.document.undo_stack
@@ -294,6 +419,8 @@ class MainWindow(QMainWindow):
         file_menu.addSeparator()
         file_menu.addActions([self.save_action, self.save_as_action, self.export_action])
         file_menu.addSeparator()
+        file_menu.addActions([self.open_session_action, self.save_session_action])
+        file_menu.addSeparator()
         file_menu.addAction(self.quit_action)
         edit_menu = menu.addMenu("&Edit")
         edit_menu.addActions([self.undo_action, self.redo_action, self.cancel_action])
@@ -305,6 +432,10 @@ class MainWindow(QMainWindow):
         view_menu.addAction(self.reset_view_action)
         view_menu.addSeparator()
         view_menu.addActions([dock.toggleViewAction() for dock in docks])
+        view_menu.addSeparator()
+        console = self.console_dock.toggleViewAction()
+        console.setShortcut(QKeySequence("Ctrl+Shift+P"))
+        view_menu.addAction(console)
         toolbar = self.addToolBar("Main")
         toolbar.setObjectName("Main")
         toolbar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
@@ -376,6 +507,43 @@ class MainWindow(QMainWindow):
         if name:
             self.open_file(Path(name))
 
+    def _open_session_dialog(self) -> None:
+        folder = str(self.document.path.parent) if self.document.path else str(Path.home())
+        name, _ = QFileDialog.getOpenFileName(self, "Open Session", folder, SESSION_FILTER)
+        if name:
+            self.open_session(Path(name))
+
+    def _replay(self, recording: list[records.Record]) -> None:
+        """The document as ``recording`` says, journalled anew; compared structures are dropped."""
+        self.journal.discard()
+        while self.comparison.items:
+            self.comparison.remove(0)
+        self.document.replay(recording)
+        self.journal.write_all()
+
+    def _view(self) -> session.View:
+        compared = [session.Compared(item.path, item.source, item.chain, item.visible)
+                    for item in self.comparison.items]
+        camera = [list(map(float, vector)) for vector in self.plotter.camera_position]
+        return session.View(sorted(layer.name for layer in self.scene.layers), self.scene.colouring.value,
+                            self.scene.fat_helices, camera, compared)
+
+    def _apply_view(self, view: session.View) -> None:
+        for layer, box in self.display_panel.layer_boxes.items():
+            box.setChecked(layer.name in view.layers)
+        panel = self.display_panel
+        panel.colouring.setCurrentIndex(max(panel.colouring.findData(Colouring(view.colouring)), 0))
+        panel.fat.setChecked(view.fat_helices)
+        for item in view.compared:
+            try:
+                self.comparison.add(item.path, item.chain, item.source)
+            except (StructureError, ValueError) as error:
+                self.statusBar().showMessage(f"compared structure {item.path.name} left out: {error}", 15000)
+                continue
+            self.comparison.set_visible(len(self.comparison.items) - 1, item.visible)
+        self.plotter.camera_position = [tuple(vector) for vector in view.camera]
+        self.plotter.render()
+
     def _write(self, path: Path) -> bool:
         try:
             self.document.save(path, overwrite=True)
@@ -426,6 +594,11 @@ class MainWindow(QMainWindow):
         pixels = np.ascontiguousarray(self.plotter.screenshot(return_img=True))
         height, width = pixels.shape[:2]
         return QImage(pixels.data, width, height, 3 * width, QImage.Format.Format_RGB888).copy()
+
+
+def time_label(path: Path) -> str:
+    """When the journal at ``path`` was last written, for people."""
+    return "last edit " + time.strftime("%Y-%m-%d %H:%M", time.localtime(path.stat().st_mtime))
 
 
 def _scrolled(widget: QWidget) -> QScrollArea:

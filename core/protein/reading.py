@@ -32,12 +32,14 @@ _BACKBONE = ("N", "CA", "C", "O")
 _PEPTIDE = (gemmi.PolymerType.PeptideL, gemmi.PolymerType.PeptideD)
 
 
-def read_structure(path: str | os.PathLike[str]) -> Structure:
+def read_structure(path: str | os.PathLike[str], data: bytes | None = None) -> Structure:
     """Read a PDB or mmCIF file (optionally gzipped); the format is taken from the content.
 
     Parameters
     ----------
     path : str or path-like
+    data : the file's content (as :func:`read_bytes` gives it) if already read; ``path`` then
+        only names it, and need not exist.
 
     Returns
     -------
@@ -50,7 +52,7 @@ def read_structure(path: str | os.PathLike[str]) -> Structure:
         coordinates; the message names the file.
     """
     path = Path(path)
-    text, fmt, st, atoms = _read_model(path)
+    text, fmt, st, atoms = _read_model(path, read_bytes(path) if data is None else data)
     notes: list[str] = []
     groups = residue_groups(atoms)
     runs = backbone_runs(atoms, groups, notes)
@@ -93,13 +95,13 @@ def read_atoms(path: str | os.PathLike[str]) -> AtomTable:
         Missing, empty or unreadable file, no atoms, or non-finite coordinates.
     """
     path = Path(path)
-    _, _, st, atoms = _read_model(path)
+    _, _, st, atoms = _read_model(path, read_bytes(path))
     return _atom_table(st.name, atoms)
 
 
-def _read_model(path: Path) -> tuple[str, str, gemmi.Structure, ScannedModel]:
+def _read_model(path: Path, data: bytes) -> tuple[str, str, gemmi.Structure, ScannedModel]:
     """Text, format, parsed structure and scanned first model of a file with finite atoms."""
-    text = _read_text(path)
+    text = _text(path, data)
     fmt = "mmcif" if _looks_like_mmcif(text) else "pdb"
     st = _parse(text, fmt, path)
     atoms = scan_model(st[0])
@@ -136,16 +138,21 @@ def _atom_table(entry_id: str, atoms: ScannedModel) -> AtomTable:
     )
 
 
-def _read_text(path: Path) -> str:
-    """File content as text, gunzipped when it starts with the gzip magic bytes."""
+def read_bytes(path: str | os.PathLike[str]) -> bytes:
+    """The content of a structure file as stored (gzipped or not); raises StructureError."""
+    path = Path(path)
     if not path.exists():
         raise StructureError(f"{path}: no such file")
     if path.is_dir():
         raise StructureError(f"{path}: is a directory, not a structure file")
     try:
-        data = path.read_bytes()
+        return path.read_bytes()
     except OSError as exc:
         raise StructureError(f"{path}: cannot read ({exc.strerror})") from None
+
+
+def _text(path: Path, data: bytes) -> str:
+    """File content as text, gunzipped when it starts with the gzip magic bytes."""
     if data[:2] == b"\x1f\x8b":
         try:
             data = gzip.decompress(data)

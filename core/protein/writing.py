@@ -84,7 +84,7 @@ def write_structure(
     except RuntimeError as exc:
         raise StructureError(f"{path}: cannot write {fmt.upper()} ({exc})") from None
     data = text.encode()
-    _atomic_write(path, gzip.compress(data, mtime=0) if compress else data)
+    atomic_write(path, gzip.compress(data, mtime=0) if compress else data)
     return path
 
 
@@ -168,7 +168,7 @@ def _mmcif_text(st: gemmi.Structure, structure: Structure) -> str:
     return doc.as_string()
 
 
-def _atomic_write(path: Path, data: bytes) -> None:
+def atomic_write(path: Path, data: bytes) -> None:
     """Write ``data`` to a temporary file next to ``path``, then rename it onto ``path``."""
     mode = path.stat().st_mode & 0o777 if path.exists() else 0o644
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")

@@ -33,6 +33,14 @@ class Questions:
 
 
 @pytest.fixture(autouse=True)
+def state_home(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """Recovery journals go to a temporary folder, never the user's."""
+    folder = tmp_path_factory.mktemp("state")
+    monkeypatch.setenv("XDG_STATE_HOME", str(folder))
+    return folder / "ribbonwave"
+
+
+@pytest.fixture(autouse=True)
 def questions(monkeypatch: pytest.MonkeyPatch) -> Questions:
     """No modal dialog may block a test: questions are answered 'Discard' unless a test says otherwise."""
     recorder = Questions()

@@ -32,7 +32,7 @@ from app.editor.scene import tube
 from app.editor.scene.curves import LevelCurve, SegmentPath
 from core.analysis.compare import pair_residues
 from core.analysis.superpose import MIN_PAIRS, Superposition, fit_closest
-from core.protein.reading import read_structure
+from core.protein.reading import read_bytes, read_structure
 from core.protein.ribbon import Ribbon, segment_ribbon
 from core.protein.structure import BackboneSegment, Structure
 
@@ -115,6 +115,8 @@ class Compared:
     """One compared structure: its chain, its superposition and its moved ribbons."""
 
     path: Path
+    source: bytes
+    """The file's bytes as read (sessions embed them)."""
     structure: Structure
     chain: str
     colour: tuple[int, int, int]
@@ -167,20 +169,22 @@ class Comparison(QObject):
         item = self.items[index]
         return [path.level_curve(ribbon, self.level(ribbon)) for ribbon, path in zip(item.ribbons, item.paths)]
 
-    def add(self, path: Path, chain: str | None = None) -> Compared:
-        """Read ``path``, superpose ``chain`` (default: its longest) on the edited chain and show it.
+    def add(self, path: Path, chain: str | None = None, data: bytes | None = None) -> Compared:
+        """Read ``path`` (or its content ``data``), superpose ``chain`` (default: its longest) on the
+        edited chain and show it.
 
         Raises :class:`core.protein.structure.StructureError` (unreadable file) or ValueError (no such
         chain, no protein, too few residue pairs, no structure open).
         """
         if self.document.model is None:
             raise ValueError("open a structure before adding structures to compare with it")
-        structure = read_structure(path)
+        data = read_bytes(path) if data is None else data
+        structure = read_structure(path, data)
         if not structure.segments:
             raise ValueError(f"{Path(path).name}: no protein chain to compare")
         colour = PALETTE[self._keys % len(PALETTE)]
         self._chain = self.document.structure.segments[self.document.segment].chain
-        item = self._fitted(Path(path), structure, chain or chains(structure)[0], colour)
+        item = self._fitted(Path(path), data, structure, chain or chains(structure)[0], colour)
         item.key = self._keys
         self._keys += 1
         self.items.append(item)
@@ -191,7 +195,7 @@ class Comparison(QObject):
         """Compare chain ``chain`` of structure ``index`` instead (raises ValueError as :meth:`add`)."""
         item = self.items[index]
         if chain != item.chain:
-            fitted = self._fitted(item.path, item.structure, chain, item.colour)
+            fitted = self._fitted(item.path, item.source, item.structure, chain, item.colour)
             fitted.key, fitted.visible = item.key, item.visible
             self.items[index] = fitted
             self.changed.emit()
@@ -207,7 +211,7 @@ class Comparison(QObject):
 
     # ------------------------------------------------------------------ internals
 
-    def _fitted(self, path: Path, structure: Structure, chain: str, colour: tuple[int, int, int],
+    def _fitted(self, path: Path, source: bytes, structure: Structure, chain: str, colour: tuple[int, int, int],
                 previous: ChainFit | None = None, previous_to: str = "") -> Compared:
         document = self.document
         segments = chain_segments(structure, chain)
@@ -220,7 +224,7 @@ class Comparison(QObject):
             fit, fitted_to = previous, previous_to
         ribbons = [segment_ribbon(s, document.kind) for s in segments]
         moved = [r.with_points(fit.motion.apply(r.points)) for r in ribbons]
-        return Compared(path, structure, chain, colour, fit, fitted_to, moved, [SegmentPath(r) for r in moved])
+        return Compared(path, source, structure, chain, colour, fit, fitted_to, moved, [SegmentPath(r) for r in moved])
 
     def _edited_chain(self) -> tuple[np.ndarray, list[BackboneSegment]]:
         document = self.document
@@ -232,7 +236,7 @@ class Comparison(QObject):
         self._chain = self.document.structure.segments[self.document.segment].chain
         refitted = []
         for item in self.items:
-            fitted = self._fitted(item.path, item.structure, item.chain, item.colour, item.fit, item.fitted_to)
+            fitted = self._fitted(item.path, item.source, item.structure, item.chain, item.colour, item.fit, item.fitted_to)
             fitted.key, fitted.visible = item.key, item.visible
             refitted.append(fitted)
         self.items = refitted

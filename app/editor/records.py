@@ -1,0 +1,132 @@
+"""The record format of journals and session files, and the replay of a recording into a document.
+
+A file is :data:`MAGIC`, then records. A record is its payload length and CRC-32 (two
+little-endian uint32), then the payload: a line of JSON (``record``, the kind of record,
+its fields, and the names, dtypes and shapes of its arrays) followed by the arrays' raw
+bytes. Arrays are
+written as they are in memory, so coordinates come back bit for bit. A file cut off
+mid-record (a crash while writing) reads as the records before the damage.
+
+Kinds: ``header`` (format version, file name, ribbon kind, the file's bytes as read),
+``push`` (an undo step pushed at a stack position: its text and :class:`~core.protein.model.Edit`),
+``index`` (the stack position after a step, undo or redo, the clean position, the file
+names, the level, segment and multiresolution switch), ``state`` (level, segment and
+multiresolution switch alone) and ``view`` (session files: layers, camera, compared
+structures).
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+import zlib
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from core.protein.model import Edit
+
+MAGIC = b"\x89RWAVE\r\n"
+"""The first bytes of a journal or session file."""
+VERSION = 1
+"""Format version written; files of a newer version are refused with a message."""
+_FRAME = struct.Struct("<II")
+_EDIT_ARRAYS = ("old_points", "new_points", "residues", "rows", "old_coords", "new_coords")
+
+
+class RecordError(ValueError):
+    """A file that is not a ribbonwave journal or session, or one of a newer version."""
+
+
+@dataclass(frozen=True)
+class Record:
+    """One record: its kind, JSON fields and named arrays."""
+
+    kind: str
+    fields: dict
+    arrays: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def encode(record: Record) -> bytes:
+    """The bytes of ``record``, framed."""
+    arrays = {name: np.ascontiguousarray(a) for name, a in record.arrays.items()}
+    meta = {**record.fields, "record": record.kind,
+            "arrays": [[name, a.dtype.str, list(a.shape)] for name, a in arrays.items()]}
+    payload = b"".join([json.dumps(meta, separators=(",", ":")).encode(), b"\n", *(a.tobytes() for a in arrays.values())])
+    return _FRAME.pack(len(payload), zlib.crc32(payload)) + payload
+
+
+def decode(data: bytes) -> tuple[list[Record], bool]:
+    """The records of a file's bytes and whether it was damaged (cut off or corrupt after
+    the last record returned). Raises RecordError for a file that is not one of ours."""
+    if not data.startswith(MAGIC):
+        raise RecordError("not a ribbonwave journal or session file")
+    records, offset = [], len(MAGIC)
+    while offset < len(data):
+        record, offset = _record_at(data, offset)
+        if record is None:
+            return records, True
+        records.append(record)
+    if records and records[0].kind == "header" and records[0].fields.get("version", 0) > VERSION:
+        raise RecordError(f"written by a newer ribbonwave (format {records[0].fields['version']}; "
+                          f"this one reads format {VERSION})")
+    if not records or records[0].kind != "header":
+        raise RecordError("no header record: not a ribbonwave journal or session file")
+    return records, False
+
+
+def _record_at(data: bytes, offset: int) -> tuple[Record | None, int]:
+    """The record framed at ``offset`` and the offset after it; None if it is incomplete or corrupt."""
+    if offset + _FRAME.size > len(data):
+        return None, offset
+    length, crc = _FRAME.unpack_from(data, offset)
+    payload = data[offset + _FRAME.size : offset + _FRAME.size + length]
+    if len(payload) != length or zlib.crc32(payload) != crc:
+        return None, offset
+    line, _, raw = payload.partition(b"\n")
+    try:
+        meta = json.loads(line)
+        arrays, start = {}, 0
+        for name, dtype, shape in meta.pop("arrays"):
+            array = np.frombuffer(raw, dtype=np.dtype(dtype), count=int(np.prod(shape)), offset=start).reshape(shape)
+            arrays[name] = array.copy()
+            start += array.nbytes
+        kind = meta.pop("record")
+    except (ValueError, KeyError, TypeError):
+        return None, offset
+    return Record(kind, meta, arrays), offset + _FRAME.size + length
+
+
+def header(path: Path, kind: str, source: bytes) -> Record:
+    """The first record: the file as read, its name and the ribbon kind."""
+    return Record("header", {"version": VERSION, "path": str(path), "kind": kind},
+                  {"source": np.frombuffer(source, dtype=np.uint8)})
+
+
+def push(at: int, text: str, edit: Edit) -> Record:
+    """An undo step ``edit`` named ``text`` pushed with the stack at position ``at``."""
+    return Record("push", {"at": at, "text": text, "segment": edit.segment},
+                  {name: getattr(edit, name) for name in _EDIT_ARRAYS})
+
+
+def edit_of(record: Record) -> Edit:
+    """The :class:`Edit` of a ``push`` record."""
+    return Edit(record.fields["segment"], *(record.arrays[name] for name in _EDIT_ARRAYS))
+
+
+def steps(records: list[Record]) -> Iterator[Record]:
+    """The ``push`` and ``index`` records, in order."""
+    return (r for r in records if r.kind in ("push", "index"))
+
+
+def source_of(record: Record) -> bytes:
+    """The file's bytes of a ``header`` record."""
+    return record.arrays["source"].tobytes()
+
+
+def read(path: Path) -> tuple[list[Record], bool]:
+    """The records of the file at ``path`` and whether it was damaged (see :func:`decode`);
+    raises OSError or RecordError."""
+    return decode(Path(path).read_bytes())

@@ -1,0 +1,147 @@
+"""``rw``: the editor as seen by scripts (``ribbonwave FILE --script S.py``) and the Python console.
+
+Every method goes the way the mouse and the menus go: :meth:`EditorAPI.move` is a drag of a
+control point (one undo step, regularized on release when the editor says so), the
+properties set the level slider and the segment, and files are written as File ▸ Save
+writes them. Errors are exceptions, never dialogs.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from app.editor.session import SUFFIX as SESSION_SUFFIX
+
+if TYPE_CHECKING:
+    from app.editor.main_window import MainWindow
+
+
+class EditorAPI:
+    """The ``rw`` object: the document of ``window`` and what can be done with it."""
+
+    def __init__(self, window: MainWindow) -> None:
+        self._window = window
+
+    @property
+    def _document(self):  # noqa: ANN202 (the Document; typed where it is used)
+        document = self._window.document
+        if document.model is None:
+            raise RuntimeError("no structure is open: rw.open(path) first")
+        return document
+
+    # ------------------------------------------------------------------ state
+
+    @property
+    def level(self) -> float:
+        """The level of the slider (Carson's: 0 .. log2 N of the current segment)."""
+        return self._document.level
+
+    @level.setter
+    def level(self, value: float) -> None:
+        self._document.set_level(float(value))
+
+    @property
+    def segment(self) -> int:
+        """The segment whose control points are shown and edited (0-based)."""
+        return self._document.segment
+
+    @segment.setter
+    def segment(self, value: int) -> None:
+        self._document.set_segment(int(value))
+
+    def points(self) -> np.ndarray:
+        """(n, 3) control points of the curve shown (the current segment at its level), Å."""
+        return self._document.level_curve().control_points.copy()
+
+    def coords(self) -> np.ndarray:
+        """(n_atoms, 3) every atom of the edited structure, Å."""
+        return self._document.model.coords.copy()
+
+    def history(self) -> tuple[list[str], int]:
+        """The names of the undo steps and the current position (steps done)."""
+        stack = self._document.undo_stack
+        return [stack.text(k) for k in range(stack.count())], stack.index()
+
+    # ------------------------------------------------------------------ edits
+
+    def move(self, index: int, delta: object) -> None:
+        """Drag control point ``index`` of the curve shown by ``delta`` (Å): one undo step."""
+        document = self._document
+        points = document.level_curve().control_points
+        if not 0 <= int(index) < len(points):
+            raise IndexError(f"control point {index} does not exist: the curve shown has {len(points)}")
+        document.pick_point(int(index))
+        document.preview_move(int(index), _vector(delta))
+        document.finish_drag(f"Move point {int(index)} at level {document.shown_level():.2f}")
+
+    def tug(self, residue: int | str, delta: object) -> None:
+        """Tug the curve shown at ``residue`` (index in the segment, or a label such as
+        ``'A:LYS48'`` or ``'48'``) by ``delta`` (Å): one undo step, as *Tug the curve* does."""
+        document = self._document
+        labels = document.labels()
+        index = _residue_index(labels, residue)
+        document.preview_tug(float(document.paths[document.segment].residue_u[index]), _vector(delta))
+        document.finish_drag(f"Tug curve at {labels[index]} at level {document.shown_level():.2f}")
+
+    def undo(self) -> None:
+        """Undo the last step (as Ctrl+Z)."""
+        self._window.undo_action.trigger()
+
+    def redo(self) -> None:
+        """Redo the next step (as Ctrl+Shift+Z)."""
+        self._window.redo_action.trigger()
+
+    # ------------------------------------------------------------------ files
+
+    def open(self, path: str | Path) -> None:
+        """Open a structure (PDB or mmCIF) or a session (``.rwsession``)."""
+        path = Path(path)
+        if path.name.endswith(SESSION_SUFFIX):
+            self._window.open_session(path, raise_errors=True)
+        else:
+            self._window.open_file(path, raise_errors=True)
+
+    def export(self, path: str | Path, *, overwrite: bool = False) -> Path:
+        """Write the structure as edited (PDB or mmCIF by the extension) without making
+        ``path`` the document's file or marking the edits saved."""
+        return self._document.model.save(Path(path), overwrite=overwrite)
+
+    def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
+        """Save as File ▸ Save As does: ``path`` becomes the document's file, the edits are saved."""
+        return self._document.save(Path(path), overwrite=overwrite)
+
+    def save_session(self, path: str | Path) -> Path:
+        """Save the session (structure, undo history, view) to ``path`` (``.rwsession`` added if missing)."""
+        return self._window.write_session(Path(path))
+
+    def screenshot(self, path: str | Path, width: int | None = None, height: int | None = None) -> Path:
+        """Save the 3D view as a PNG image, ``width`` x ``height`` pixels (default: the view's size)."""
+        return self._window.export_view(Path(path), width, height)
+
+    def quit(self, discard: bool = False) -> None:
+        """Close the editor. Unsaved edits stay in the recovery journal unless ``discard``."""
+        self._window.quit_unattended(discard)
+
+
+def _vector(delta: object) -> np.ndarray:
+    vector = np.asarray(delta, dtype=np.float64).reshape(-1)
+    if vector.shape != (3,) or not np.all(np.isfinite(vector)):
+        raise ValueError(f"delta must be three finite numbers (Å); got {delta!r}")
+    return vector
+
+
+def _residue_index(labels: tuple[str, ...], residue: int | str) -> int:
+    """Index of ``residue`` (an index, 'A:LYS48', or a number with insertion code '48A')."""
+    if isinstance(residue, (int, np.integer)):
+        if not 0 <= residue < len(labels):
+            raise IndexError(f"residue {residue} does not exist: the segment has {len(labels)}")
+        return int(residue)
+    text = str(residue).strip()
+    for k, label in enumerate(labels):
+        number = label.split(":", 1)[1].lstrip("ABCDEFGHIJKLMNOPQRSTUVWXYZ")
+        if text in (label, number):
+            return k
+    raise ValueError(f"no residue {residue!r} in this segment ({labels[0]}–{labels[-1]})")

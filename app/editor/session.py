@@ -1,0 +1,84 @@
+"""Session files (``.rwsession``): a modelling session to come back to.
+
+A session holds the structure as read (embedded: it opens when the original file has
+moved), the whole undo history at its position, the level, segment and ribbon kind
+(:meth:`~app.editor.document.Document.recording`), and a ``view`` record: the display
+layers and colouring, the camera and the compared structures (embedded too). It is the
+record format of journals (:mod:`app.editor.records`), written atomically.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from app.editor import records
+from core.protein.writing import atomic_write
+
+SUFFIX = ".rwsession"
+
+
+class SessionError(ValueError):
+    """A session file that cannot be opened; the message names the file and says why."""
+
+
+@dataclass(frozen=True)
+class Compared:
+    """A compared structure of a session: its file name and bytes, chain and visibility."""
+
+    path: Path
+    source: bytes
+    chain: str
+    visible: bool
+
+
+@dataclass(frozen=True)
+class View:
+    """What a session shows besides the document."""
+
+    layers: list[str]
+    colouring: str
+    fat_helices: bool
+    camera: list[list[float]]
+    compared: list[Compared]
+
+    def record(self) -> records.Record:
+        """The ``view`` record of this view."""
+        fields = {"layers": self.layers, "colouring": self.colouring, "fat_helices": self.fat_helices,
+                  "camera": self.camera,
+                  "compared": [{"path": str(c.path), "chain": c.chain, "visible": c.visible} for c in self.compared]}
+        arrays = {f"compared_{k}": np.frombuffer(c.source, dtype=np.uint8) for k, c in enumerate(self.compared)}
+        return records.Record("view", fields, arrays)
+
+    @classmethod
+    def of(cls, record: records.Record) -> View:
+        """The view of a ``view`` record."""
+        fields = record.fields
+        compared = [Compared(Path(c["path"]), record.arrays[f"compared_{k}"].tobytes(), c["chain"], c["visible"])
+                    for k, c in enumerate(fields["compared"])]
+        return cls(fields["layers"], fields["colouring"], fields["fat_helices"], fields["camera"], compared)
+
+
+def write(path: Path, recording: list[records.Record], view: View) -> None:
+    """Write a session atomically (a temporary file beside ``path``, then a rename)."""
+    atomic_write(Path(path), records.MAGIC + b"".join(records.encode(r) for r in [*recording, view.record()]))
+
+
+def read(path: Path) -> tuple[list[records.Record], View]:
+    """The document's recording and the view of the session at ``path`` (raises SessionError)."""
+    path = Path(path)
+    try:
+        recording, damaged = records.read(path)
+    except OSError as error:
+        raise SessionError(f"{path}: cannot read ({error.strerror})") from None
+    except records.RecordError as error:
+        raise SessionError(f"{path}: {error}") from None
+    views = [r for r in recording if r.kind == "view"]
+    if damaged or not views:
+        raise SessionError(f"{path}: the session file is damaged (incomplete)")
+    try:
+        return [r for r in recording if r.kind != "view"], View.of(views[-1])
+    except (KeyError, TypeError, ValueError) as error:
+        raise SessionError(f"{path}: the session file is damaged ({error})") from None

@@ -1,0 +1,249 @@
+"""Crash recovery: every undo step journalled as it happens, restored bit for bit after a crash."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PySide6.QtWidgets import QMessageBox
+from pytestqt.qtbot import QtBot
+from test_window import _drag_control_point, _window
+
+from app.editor import journal, records
+from app.editor.main_window import MainWindow
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def _edit(window: MainWindow, which: int, offset: tuple[int, int] = (30, 20)) -> None:
+    _drag_control_point(window, which % len(window.scene.shown_control_points()), offset, steps=2)
+
+
+def _journal_records(window: MainWindow) -> list[records.Record]:
+    recording, damaged = records.read(window.journal.path)
+    assert not damaged
+    return recording
+
+
+# ---------------------------------------------------------------------------- the format
+
+
+def test_records_round_trip_bit_for_bit() -> None:
+    rng = np.random.default_rng(3)
+    arrays = {"coords": rng.normal(size=(17, 3)), "rows": np.arange(17, dtype=np.int64) * 3, "empty": np.zeros((0, 3))}
+    record = records.Record("push", {"text": "Move point 3", "at": 2}, arrays)
+    (back,), damaged = records.decode(records.MAGIC + records.encode(records.header(Path("x.pdb"), "peptide", b"ab"))
+                                      + records.encode(record))[0][1:], False
+    assert back.kind == "push" and back.fields == record.fields and not damaged
+    for name, array in arrays.items():
+        assert back.arrays[name].dtype == array.dtype and np.array_equal(back.arrays[name], array)
+        assert back.arrays[name].tobytes() == array.tobytes()
+
+
+def test_a_journal_cut_anywhere_gives_the_records_before_the_cut(qtbot: QtBot) -> None:
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    for k in range(3):
+        _edit(window, k + 2)
+    data = window.journal.path.read_bytes()
+    whole, damaged = records.decode(data)
+    assert not damaged and [r.kind for r in whole].count("push") == 3
+    ends = np.cumsum([len(records.MAGIC)] + [len(records.encode(r)) for r in whole])
+    for cut in range(int(ends[0]) + 1, len(data), 97):  # every 97th byte: inside headers, JSON and arrays
+        got, damaged = records.decode(data[:cut])
+        complete = int(np.searchsorted(ends, cut, side="right")) - 1
+        assert damaged == (cut not in ends) and len(got) == complete
+    flipped = bytearray(data)
+    flipped[int(ends[2]) + 20] ^= 0xFF  # a corrupt byte inside the second push: the CRC catches it
+    got, damaged = records.decode(bytes(flipped))
+    assert damaged and len(got) == 2
+
+
+def test_not_a_journal_or_a_newer_one_is_refused() -> None:
+    with pytest.raises(records.RecordError, match="not a ribbonwave"):
+        records.decode(b"HEADER    PROTEIN\n")
+    newer = records.Record("header", {"version": records.VERSION + 1, "path": "x", "kind": "peptide"})
+    with pytest.raises(records.RecordError, match="newer ribbonwave"):
+        records.decode(records.MAGIC + records.encode(newer))
+
+
+# ---------------------------------------------------------------------------- journalling
+
+
+def test_every_step_is_appended_as_a_delta(qtbot: QtBot, state_home: Path) -> None:
+    window = _window(qtbot, DATA / "4YVS.cif.gz")
+    assert window.journal.path is None  # nothing journalled before the first step
+    _edit(window, 3)
+    path = window.journal.path
+    assert path.parent == state_home and path.stat().st_size > len(window.document.source)
+    sizes = [path.stat().st_size]
+    stack = window.document.undo_stack
+    for k in range(3):
+        _edit(window, 5 + k)
+        sizes.append(path.stat().st_size)
+        edit = stack.command(stack.index() - 1).edit
+        arrays = sum(a.nbytes for a in (edit.old_points, edit.new_points, edit.residues, edit.rows, edit.old_coords,
+                                        edit.new_coords))
+        assert arrays < sizes[-1] - sizes[-2] < arrays + 1024  # the edit's deltas and a line of JSON
+        assert sizes[-1] - sizes[-2] < window.document.model.coords.nbytes / 10  # not the model
+    window.undo_action.trigger()
+    kinds = [r.kind for r in _journal_records(window)]
+    assert kinds == ["header", "push", "index", "push", "index", "push", "index", "push", "index", "index"]
+    assert _journal_records(window)[-1].fields["index"] == 3
+
+
+def test_level_and_segment_are_journalled_soon_after_they_change(qtbot: QtBot) -> None:
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    _edit(window, 3)
+    window.document.set_level(2.5)
+    qtbot.waitUntil(lambda: _journal_records(window)[-1].kind == "state", timeout=1000)
+    assert _journal_records(window)[-1].fields["level"] == 2.5
+
+
+def test_a_clean_close_removes_the_journal(qtbot: QtBot, questions) -> None:
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    _edit(window, 3)
+    path = window.journal.path
+    questions.answer = QMessageBox.StandardButton.Discard
+    window.close()
+    assert not path.exists()
+
+
+def test_a_saved_document_closes_without_its_journal(qtbot: QtBot, tmp_path: Path) -> None:
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    _edit(window, 3)
+    path = window.journal.path
+    window.document.save(tmp_path / "saved.pdb")
+    window.close()
+    assert not path.exists()
+
+
+def test_an_unattended_close_keeps_unsaved_edits(qtbot: QtBot, questions) -> None:
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    _edit(window, 3)
+    window.unattended = True
+    path = window.journal.path
+    window.close()
+    assert path.exists() and not questions.asked
+    assert journal.orphans(path.parent) == [path]  # nobody holds it any more
+
+
+def test_the_next_start_offers_to_restore(qtbot: QtBot, questions) -> None:
+    crashed = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    for k in range(4):
+        _edit(crashed, k + 2)
+    crashed.undo_action.trigger()
+    coords, history = crashed.document.model.coords.copy(), crashed.rw.history()
+    crashed.unattended = True
+    crashed.close()  # as a crash leaves it: the journal stays
+    window = _window(qtbot, DATA / "3PTB.pdb.gz")
+    questions.answer = QMessageBox.StandardButton.Yes
+    window.offer_recovery()
+    assert "did not close cleanly" in questions.asked[-1]
+    assert window.rw.history() == history and np.array_equal(window.document.model.coords, coords)
+    assert window.document.modified and window.document.path.name == "1UBQ.pdb.gz"
+    window.redo_action.trigger()
+    window.undo_action.trigger()
+    assert np.array_equal(window.document.model.coords, coords)
+    assert journal.orphans(window.journal.folder) == []  # the restored history is journalled anew, held
+
+
+def test_a_damaged_journal_restores_the_steps_before_the_damage(qtbot: QtBot) -> None:
+    crashed = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    states = []
+    for k in range(3):
+        _edit(crashed, k + 2)
+        states.append(crashed.document.model.coords.copy())
+    path = crashed.journal.path
+    crashed.unattended = True
+    crashed.close()
+    data = path.read_bytes()
+    path.write_bytes(data[:-30])  # the last record cut off mid-write
+    window = _window(qtbot, DATA / "3PTB.pdb.gz")
+    message = window.restore_journal(path)
+    assert "cut off" in message and window.rw.history()[1] == 3
+    assert np.array_equal(window.document.model.coords, states[2])  # the cut-off record was the last index only
+    path.write_bytes(data[: len(data) // 2])
+    window.restore_journal(path)
+    count = window.document.undo_stack.count()
+    assert 0 < count < 3 and np.array_equal(window.document.model.coords, states[count - 1])
+
+
+# ---------------------------------------------------------------------------- kill -9
+
+
+STEPS = """
+import json, os
+import numpy as np
+out = os.environ["RW_OUT"]
+for k in range(40):
+    if k % 5 == 4:
+        rw.undo()
+    else:
+        rw.move(k % 7 + 2, [1.5 * (-1) ** k, 1.0, 0.5])
+    name, index = rw.history()
+    np.save(f"{out}/coords.npy.tmp.npy", rw.coords())
+    os.replace(f"{out}/coords.npy.tmp.npy", f"{out}/coords.npy")
+    with open(f"{out}/history.tmp", "w") as f:
+        json.dump([name, index, k], f)
+    os.replace(f"{out}/history.tmp", f"{out}/history.json")
+"""
+CHECK = """
+import json, os
+import numpy as np
+out = os.environ["RW_OUT"]
+np.save(f"{out}/recovered.npy", rw.coords())
+name, index = rw.history()
+rw.undo()
+np.save(f"{out}/undone.npy", rw.coords())
+rw.redo()
+rw.redo()
+np.save(f"{out}/redone.npy", rw.coords())
+with open(f"{out}/recovered.json", "w") as f:
+    json.dump([name, index], f)
+rw.quit(discard=True)
+"""
+
+
+@pytest.mark.parametrize("after", [1, 9, 23])
+def test_kill_9_at_any_moment_then_recover(tmp_path: Path, state_home: Path, after: int) -> None:
+    """A scripted session killed (SIGKILL) while it works; ``--recover`` gives back the undo
+    history and the coordinates exactly: those of the last step the script reported, or of
+    the step in flight if it reached the journal (then undo gives the reported ones)."""
+    env = {**os.environ, "RW_OUT": str(tmp_path), "XDG_STATE_HOME": str(state_home.parent)}
+    (tmp_path / "steps.py").write_text(STEPS)
+    (tmp_path / "check.py").write_text(CHECK)
+    command = [sys.executable, "-m", "app", str(DATA / "1UBQ.pdb.gz"), "--script", str(tmp_path / "steps.py")]
+    with (tmp_path / "stderr.txt").open("wb") as stderr:
+        child = subprocess.Popen(command, cwd=ROOT, env=env, stderr=stderr)
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and child.poll() is None:
+            progress = tmp_path / "history.json"
+            if progress.exists() and json.loads(progress.read_text())[2] >= after:
+                break
+            time.sleep(0.005)
+        running = child.poll() is None
+        os.kill(child.pid, signal.SIGKILL)
+        child.wait()
+    assert running, (tmp_path / "stderr.txt").read_text()[-2000:]
+    names, index, _ = json.loads((tmp_path / "history.json").read_text())
+    reported = np.load(tmp_path / "coords.npy")
+    result = subprocess.run([sys.executable, "-m", "app", "--recover", "--script", str(tmp_path / "check.py")],
+                            cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr[-2000:]
+    recovered_names, recovered_index = json.loads((tmp_path / "recovered.json").read_text())
+    recovered = np.load(tmp_path / "recovered.npy")
+    if (recovered_names, recovered_index) == (names, index):
+        assert np.array_equal(recovered, reported)
+    elif recovered_index == index + 1:  # a move in flight was journalled before the kill
+        assert recovered_names[:index] == names[:index]
+        assert np.array_equal(np.load(tmp_path / "undone.npy"), reported)
+    else:  # an undo in flight was journalled before the kill
+        assert (recovered_names, recovered_index) == (names, index - 1)
+        assert np.array_equal(np.load(tmp_path / "redone.npy"), reported)
+    assert list(state_home.glob("*.rwjournal")) == []  # restored, then discarded by the check script
