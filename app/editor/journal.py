@@ -19,6 +19,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import shiboken6
 from PySide6.QtCore import QObject, QTimer
 
 from app.editor import records
@@ -101,9 +102,9 @@ class Journal(QObject):
 
     def _step(self) -> None:
         document = self.document
-        if document.replaying or document.model is None:
-            return
         stack = document.undo_stack
+        if not shiboken6.isValid(stack) or document.replaying or document.model is None:
+            return  # a stack being destroyed (its document dropped) reports its last changes
         if self._fd is None:
             if stack.count() == 0:
                 return

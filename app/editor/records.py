@@ -20,7 +20,6 @@ from __future__ import annotations
 import json
 import struct
 import zlib
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -114,11 +113,6 @@ def push(at: int, text: str, edit: Edit) -> Record:
 def edit_of(record: Record) -> Edit:
     """The :class:`Edit` of a ``push`` record."""
     return Edit(record.fields["segment"], *(record.arrays[name] for name in _EDIT_ARRAYS))
-
-
-def steps(records: list[Record]) -> Iterator[Record]:
-    """The ``push`` and ``index`` records, in order."""
-    return (r for r in records if r.kind in ("push", "index"))
 
 
 def source_of(record: Record) -> bytes:

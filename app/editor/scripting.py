@@ -16,6 +16,7 @@ import numpy as np
 from app.editor.session import SUFFIX as SESSION_SUFFIX
 
 if TYPE_CHECKING:
+    from app.editor.document import Document
     from app.editor.main_window import MainWindow
 
 
@@ -26,7 +27,7 @@ class EditorAPI:
         self._window = window
 
     @property
-    def _document(self):  # noqa: ANN202 (the Document; typed where it is used)
+    def _document(self) -> Document:
         document = self._window.document
         if document.model is None:
             raise RuntimeError("no structure is open: rw.open(path) first")

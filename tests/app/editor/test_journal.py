@@ -151,6 +151,7 @@ def test_the_next_start_offers_to_restore(qtbot: QtBot, questions) -> None:
     window.undo_action.trigger()
     assert np.array_equal(window.document.model.coords, coords)
     assert journal.orphans(window.journal.folder) == []  # the restored history is journalled anew, held
+    questions.answer = QMessageBox.StandardButton.Discard  # for the windows' close after the test
 
 
 def test_a_damaged_journal_restores_the_steps_before_the_damage(qtbot: QtBot) -> None:

@@ -1,0 +1,146 @@
+"""Session files: the structure as read, the undo history at its position and the view, bit for bit."""
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PySide6.QtWidgets import QFileDialog
+from pytestqt.qtbot import QtBot
+from test_window import _window
+
+from app.editor import records
+from app.editor.main_window import MainWindow
+from app.editor.scene.molecule import Colouring
+from app.editor.scene.scene import Layer
+from app.main import main
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+PROTEINS = sorted(p for p in DATA.glob("*.gz") if p.name != "1BNA.pdb.gz")  # 1BNA: DNA only
+
+
+def _states(window: MainWindow) -> list[np.ndarray]:
+    """The coordinates at every position of the undo history (the stack left where it was)."""
+    stack, states = window.document.undo_stack, []
+    index = stack.index()
+    for k in range(stack.count() + 1):
+        stack.setIndex(k)
+        states.append(window.document.model.coords.copy())
+    stack.setIndex(index)
+    return states
+
+
+@pytest.mark.parametrize("path", PROTEINS, ids=[p.name.split(".")[0] for p in PROTEINS])
+def test_a_session_round_trips_bit_for_bit(qtbot: QtBot, tmp_path: Path, path: Path) -> None:
+    window = _window(qtbot, path)
+    rw = window.rw
+    window.document.set_regularization(on_release=path.name == "1UBQ.pdb.gz")  # the regularized steps of one
+    if path.name == "1L2Y.pdb.gz":
+        window.document.set_kind("calpha")  # and the Cα ribbon of another
+    kind = window.document.kind
+    rw.level = max(rw.level - 1, 0)
+    n = len(rw.points())
+    rw.move(n // 2, [2.0, -1.0, 0.5])
+    rw.move(n // 3, [0.0, 1.5, 1.0])
+    rw.undo()
+    rw.tug(len(window.document.labels()) // 2, [1.0, 1.0, -1.0])
+    rw.move(n - 1, [0.5, 0.5, 0.5])
+    rw.undo()
+    history, states, level = rw.history(), _states(window), rw.level
+    saved = window.write_session(tmp_path / "work")
+    assert saved.name == "work.rwsession"
+    window.document.undo_stack.setClean()  # no question on the way out
+    assert window.open_file(DATA / "3PTB.pdb.gz")
+    assert window.open_session(saved)
+    assert rw.history() == history and rw.level == level and window.document.modified
+    assert window.document.kind is kind
+    assert all(np.array_equal(a, b) for a, b in zip(_states(window), states, strict=True))
+    rw.redo()
+    assert np.array_equal(rw.coords(), states[-1])
+
+
+def test_the_view_and_compared_structures_come_back(qtbot: QtBot, tmp_path: Path) -> None:
+    compared = tmp_path / "elastase.pdb.gz"
+    shutil.copy(DATA / "1BMA.pdb.gz", compared)
+    window = _window(qtbot, DATA / "3PTB.pdb.gz")
+    window.comparison.add(compared)
+    window.comparison.set_visible(0, False)
+    window.display_panel.layer_boxes[Layer.TUBE].setChecked(False)
+    window.display_panel.layer_boxes[Layer.ATOMS].setChecked(True)
+    panel = window.display_panel
+    panel.colouring.setCurrentIndex(panel.colouring.findData(Colouring.CHAIN))
+    panel.fat.setChecked(True)
+    window.plotter.camera.azimuth = 40
+    camera = np.array([tuple(v) for v in window.plotter.camera_position])
+    layers = set(window.scene.layers)
+    saved = window.write_session(tmp_path / "view.rwsession")
+    compared.unlink()  # the session embeds the compared structure too
+    other = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    assert other.open_session(saved)
+    assert other.scene.layers == layers and other.scene.colouring is Colouring.CHAIN and other.scene.fat_helices
+    assert np.allclose([tuple(v) for v in other.plotter.camera_position], camera)
+    assert [(item.structure.entry_id, item.visible) for item in other.comparison.items] == [("1BMA", False)]
+    assert other.comparison.items[0].fit.rms_core == pytest.approx(window.comparison.items[0].fit.rms_core)
+
+
+def test_a_session_opens_when_the_structure_file_has_moved(qtbot: QtBot, tmp_path: Path) -> None:
+    original = tmp_path / "ubiquitin.pdb.gz"
+    shutil.copy(DATA / "1UBQ.pdb.gz", original)
+    window = _window(qtbot, original)
+    window.rw.move(5, [3.0, 0.0, 0.0])
+    coords = window.rw.coords()
+    saved = window.write_session(tmp_path / "s.rwsession")
+    original.unlink()
+    window.document.undo_stack.setClean()
+    assert window.open_session(saved)
+    assert np.array_equal(window.rw.coords(), coords) and window.document.path == original
+
+
+def test_bad_sessions_give_a_message(qtbot: QtBot, tmp_path: Path, errors: list[str],
+                                     capsys: pytest.CaptureFixture[str]) -> None:
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    window.rw.move(5, [3.0, 0.0, 0.0])
+    saved = window.write_session(tmp_path / "s.rwsession")
+    data = saved.read_bytes()
+    newer = records.Record("header", {"version": records.VERSION + 1, "path": "x.pdb", "kind": "peptide"})
+    cases = {
+        "newer.rwsession": (records.MAGIC + records.encode(newer), "newer ribbonwave"),
+        "cut.rwsession": (data[: len(data) - 100], "damaged"),
+        "text.rwsession": (b"HEADER    not a session\n", "not a ribbonwave"),
+    }
+    for name, (content, message) in cases.items():
+        (tmp_path / name).write_bytes(content)
+        window.document.undo_stack.setClean()
+        assert not window.open_session(tmp_path / name)
+        assert message in errors[-1] and name in errors[-1]
+        assert main([str(tmp_path / name), "--screenshot", str(tmp_path / "x.png")]) == 1
+        err = capsys.readouterr().err
+        assert err.startswith("ribbonwave: error:") and message in err and "Traceback" not in err
+
+
+def test_saving_a_session_is_atomic(qtbot: QtBot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    saved = window.write_session(tmp_path / "s.rwsession")
+    before = saved.read_bytes()
+    window.rw.move(5, [3.0, 0.0, 0.0])
+
+    def full_disk(*args: object) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr("core.protein.writing.os.replace", full_disk)
+    with pytest.raises(OSError):
+        window.write_session(saved)
+    assert saved.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["s.rwsession"]
+
+
+def test_the_file_menu_saves_and_opens_sessions(qtbot: QtBot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    window.rw.move(5, [3.0, 0.0, 0.0])
+    coords = window.rw.coords()
+    target = tmp_path / "menu"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(target), ""))
+    window.save_session_action.trigger()
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", lambda *a, **k: (str(target) + ".rwsession", ""))
+    window.rw.undo()
+    window.open_session_action.trigger()  # the conftest answers 'Discard' to the unsaved edits
+    assert np.array_equal(window.rw.coords(), coords) and window.rw.history()[1] == 1
