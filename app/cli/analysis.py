@@ -11,13 +11,17 @@ from __future__ import annotations
 import argparse
 import contextlib
 import csv
+import ctypes
 import functools
 import io
 import json
 import multiprocessing
 import os
 import re
+import shutil
+import signal
 import sys
+import tempfile
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
@@ -50,6 +54,11 @@ from core.protein.structure import BackboneSegment, Structure
 SUMMARY_COLUMNS = ("ribbon", "mode", "depth", "class", "n_residues", "rms", "sd")
 RESIDUE_COLUMNS = ("file", "entry", "chain", "curve", "resseq", "icode", "resname", "ss", "class")
 OUTPUTS = ("residues.csv", "summary.csv", "skipped.csv", "fig7.png")
+STAGING_PREFIX = ".analyze-"
+"""Outputs are written into a new folder ``OUTDIR/.analyze-PID-XXXXXXXX``, then moved into place."""
+PR_SET_PDEATHSIG = 1
+"""prctl(2): the signal a process gets when its parent ends."""
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
 STRUCTURE_SUFFIXES = (".pdb", ".ent", ".cif", ".mmcif")
 CA_CA = 3.8
 """Ideal Cα–Cα distance (Å): the rms a coarse curve should stay below (Carson 1996)."""
@@ -100,7 +109,7 @@ def run_analyze(args: argparse.Namespace) -> int:
     _prepare_output(args.output, args.overwrite)
     pooled, skipped = PooledStatistics(options), []
     waiting: dict[int, Outcome] = {}  # finished out of order
-    with (_atomic_path(args.output / "residues.csv") as table_path, table_path.open("w", encoding="utf-8") as table,
+    with (_staging(args.output) as staging, (staging / "residues.csv").open("w", encoding="utf-8") as table,
           tqdm(total=len(paths), unit="file", desc="analysing", file=sys.stderr, mininterval=0.5) as progress):
         table.write(",".join(RESIDUE_COLUMNS + tuple(c.name for c in options.columns)) + "\n")
         for index, (result, lines) in _run(paths, options, args.jobs, args.scheduler):
@@ -115,12 +124,18 @@ def run_analyze(args: argparse.Namespace) -> int:
                 else:
                     pooled.add(ready)
                     table.write(lines)
-    rows = pooled.rows()
-    _atomic_text(args.output / "summary.csv", summary_csv(rows))
-    _atomic_text(args.output / "skipped.csv", _csv_text([("file", "reason")] + [(str(s.path), s.reason) for s in skipped]))
-    with _atomic_path(args.output / "fig7.png") as png:
-        plot_fig7(rows, png)
+        table.close()
+        rows = pooled.rows()
+        (staging / "summary.csv").write_text(summary_csv(rows), encoding="utf-8")
+        (staging / "skipped.csv").write_text(
+            _csv_text([("file", "reason")] + [(_cell(str(s.path)), _cell(s.reason)) for s in skipped]), encoding="utf-8")
+        plot_fig7(rows, staging / "fig7.png")
+        for name in OUTPUTS:  # all four at once, at the end: a killed run leaves the old set
+            os.replace(staging / name, args.output / name)
     print(summary_text(pooled, skipped, args.output))
+    if not pooled.n_files:
+        raise InputError(f"no file could be analysed: all {len(skipped)} were skipped "
+                         f"(see {args.output / 'skipped.csv'})")
     return 0
 
 
@@ -150,9 +165,9 @@ def _run(paths: list[Path], options: AnalysisOptions, jobs: int, scheduler: str 
         for index, path in enumerate(paths):
             yield index, analyse_file(path, options)
     else:
-        context = multiprocessing.get_context("forkserver")  # no fork of a threaded parent
-        context.set_forkserver_preload(["app.cli.analysis"])
-        with ProcessPoolExecutor(min(jobs, len(paths)), mp_context=context) as pool:
+        context = multiprocessing.get_context("spawn")  # no fork of a threaded parent; workers are its children
+        with ProcessPoolExecutor(min(jobs, len(paths)), mp_context=context, initializer=_end_with_parent,
+                                 initargs=(os.getpid(),)) as pool:
             futures = {pool.submit(analyse_file, path, options): index for index, path in enumerate(paths)}
             try:
                 for future in as_completed(futures):
@@ -192,6 +207,15 @@ def analyse_file(path: Path, options: AnalysisOptions) -> Outcome:
     return result, residue_lines(result) if isinstance(result, FileAnalysis) else ""
 
 
+def _end_with_parent(parent: int) -> None:
+    """In a worker (Linux): be killed when ``analyze`` (process ``parent``, which started it)
+    ends, so that killing ``analyze`` leaves no worker behind."""
+    if sys.platform.startswith("linux"):
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+        if os.getppid() != parent:  # it ended while this worker started
+            os._exit(1)
+
+
 def _outcome(future, path: Path) -> Outcome:
     """A finished task's outcome; a worker that died gives a skipped file, not a failed run."""
     try:
@@ -201,15 +225,50 @@ def _outcome(future, path: Path) -> Outcome:
 
 
 def _prepare_output(folder: Path, overwrite: bool) -> None:
+    """Check the output folder before any work: creatable, writable, and no outputs to replace
+    unless ``overwrite``; remove what runs killed in it left behind."""
     if folder.exists() and not folder.is_dir():
         raise InputError(f"{folder}: exists and is not a folder")
-    existing = [name for name in OUTPUTS if (folder / name).exists()]
+    existing = [name for name in OUTPUTS if (folder / name).is_symlink() or (folder / name).exists()]
     if existing and not overwrite:
         raise InputError(f"{folder}: already has {', '.join(existing)}; use --overwrite to replace them")
+    for name in existing:
+        if (folder / name).is_dir() and not (folder / name).is_symlink():
+            raise InputError(f"{folder / name}: is a folder; remove it or choose another output folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise InputError(f"{folder}: cannot create the folder ({error.strerror})") from None
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(f"{folder}: cannot write in the folder (permission denied)")
+    for stale in folder.glob(f"{STAGING_PREFIX}*"):
+        pid = stale.name.removeprefix(STAGING_PREFIX).split("-")[0]
+        if stale.is_dir() and not stale.is_symlink() and pid.isdigit() and not _alive(int(pid)):
+            shutil.rmtree(stale, ignore_errors=True)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+@contextlib.contextmanager
+def _staging(folder: Path) -> Iterator[Path]:
+    """A new private folder inside ``folder`` (an unpredictable name, mode 0700: no link
+    planted in it can redirect a write) for the outputs until they move into place."""
+    try:
+        staging = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{os.getpid()}-", dir=folder))
+    except OSError as error:
+        raise InputError(f"{folder}: cannot write in the folder ({error.strerror})") from None
+    try:
+        yield staging
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
 
 
 def residue_lines(analysis: FileAnalysis) -> str:
@@ -301,7 +360,8 @@ def plot_fig7(rows: list[SummaryRow], path: Path) -> None:
             ax.set_xlabel("decomposition step")
             ax.grid(alpha=0.3)
         axes[i][0].set_ylabel("|Cα − $C^r$| (Å): rms ± 1 SD")
-    axes[0][0].legend(title="residues", fontsize=8)
+    if rows:
+        axes[0][0].legend(title="residues", fontsize=8)
     figure.suptitle("Distance of the Cα to the low-resolution curve (after Carson 1996, Fig. 7)")
     figure.savefig(path, dpi=110, format="png")
 
@@ -466,10 +526,17 @@ def _chain_pair(text: str) -> tuple[str, str]:
 
 @functools.lru_cache(maxsize=None)
 def _field(text: str) -> str:
-    """``text`` as one CSV field (quoted only when it needs to be)."""
+    """``text`` as one CSV field (quoted only when it needs to be; see :func:`_cell`)."""
+    text = _cell(text)
     if any(c in text for c in ',"\r\n'):
         return '"' + text.replace('"', '""') + '"'
     return text
+
+
+def _cell(text: str) -> str:
+    """Text a spreadsheet shows as text: a leading ``=``, ``+``, ``-``, ``@``, tab or CR would
+    start a formula, so such text gets a leading apostrophe (OWASP's advice on CSV injection)."""
+    return "'" + text if text[:1] in FORMULA_STARTS else text
 
 
 def _csv_text(rows: list[tuple]) -> str:
@@ -478,17 +545,3 @@ def _csv_text(rows: list[tuple]) -> str:
     return out.getvalue()
 
 
-def _atomic_text(path: Path, text: str) -> None:
-    with _atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
-
-
-@contextlib.contextmanager
-def _atomic_path(path: Path) -> Iterator[Path]:
-    """A temporary path next to ``path`` that replaces ``path`` when the block succeeds."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)

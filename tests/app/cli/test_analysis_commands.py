@@ -228,3 +228,107 @@ def test_compare_two_entries_by_alignment_with_a_user_core(capsys):
 )
 def test_compare_bad_input(argv, status, message, capsys):
     expect_exit_status(argv, status, message, capsys)
+
+
+# ----------------------------------------------------------------------- hostile inputs
+
+
+def test_analyze_exits_1_when_every_file_was_skipped(tmp_path, capsys):
+    (tmp_path / "in").mkdir()
+    shutil.copy(DATA / "1BNA.pdb.gz", tmp_path / "in")  # DNA only
+    (tmp_path / "in" / "junk.pdb").write_text("not a structure\n")
+    status, _, err = run(capsys, "analyze", tmp_path / "in", "-o", tmp_path / "out", "--jobs", "1")
+    assert status == 1 and "no file could be analysed: all 2 were skipped" in err
+    assert len(read_csv(tmp_path / "out" / "skipped.csv")) == 2  # the reasons are written all the same
+
+
+def test_analyze_into_a_folder_it_cannot_write(tmp_path, capsys):
+    status, _, err = run(capsys, "analyze", DATA / "1UBQ.pdb.gz", "-o", "/proc", "--jobs", "1")
+    assert status == 1 and err.startswith("ribbonwave: error: /proc: cannot write in the folder")
+    assert "Traceback" not in err
+
+
+def test_analyze_writes_through_no_planted_link(tmp_path, capsys):
+    """Outputs replaced with --overwrite that are links to another file: the link is replaced,
+    the file it pointed to is untouched; the outputs are written in a private folder first."""
+    out = tmp_path / "out"
+    out.mkdir()
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    for name in ("residues.csv", "summary.csv", "skipped.csv", "fig7.png"):
+        (out / name).symlink_to(victim)
+    status, _, _ = run(capsys, "analyze", DATA / "1UBQ.pdb.gz", "-o", out, "--overwrite", "--jobs", "1")
+    assert status == 0 and victim.read_text() == "precious\n"
+    assert all((out / name).is_file() and not (out / name).is_symlink() for name in ("residues.csv", "fig7.png"))
+    assert sorted(p.name for p in out.iterdir()) == ["fig7.png", "residues.csv", "skipped.csv", "summary.csv"]
+
+
+def test_entry_names_that_look_like_formulas_stay_text(tmp_path, capsys):
+    import gzip
+
+    (tmp_path / "in").mkdir()
+    text = gzip.decompress((DATA / "1UBQ.pdb.gz").read_bytes()).decode()
+    (tmp_path / "in" / "crafted.pdb").write_text(text.replace("02-JAN-87   1UBQ", "02-JAN-87   =1+2", 1))
+    (tmp_path / "in" / "@SUM.pdb").write_text("garbage\n")
+    status, _, _ = run(capsys, "analyze", tmp_path / "in", "-o", tmp_path / "out", "--jobs", "1")
+    assert status == 0
+    rows = read_csv(tmp_path / "out" / "residues.csv")
+    assert {row["entry"] for row in rows} == {"'=1+2"}
+    skipped = read_csv(tmp_path / "out" / "skipped.csv")
+    assert skipped[0]["file"].endswith("@SUM.pdb") and not skipped[0]["reason"][:1] in "=+-@"
+
+
+def _descendants(pid: int) -> set[int]:
+    children: dict[int, list[int]] = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        children.setdefault(int(fields[1]), []).append(int(stat.parent.name))
+    found, todo = set(), [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.add(child)
+            todo.append(child)
+    return found
+
+
+def _running(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def test_killing_analyze_leaves_no_worker_and_the_next_run_cleans_up(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    (tmp_path / "in").mkdir()
+    for k in range(40):
+        shutil.copy(DATA / "1TIM.pdb.gz", tmp_path / "in" / f"tim{k:02}.pdb.gz")
+    out = tmp_path / "out"
+    command = [sys.executable, "-m", "app", "analyze", str(tmp_path / "in"), "-o", str(out), "--jobs", "2"]
+    child = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    workers: set[int] = set()
+    while time.monotonic() < deadline and len(workers) < 3:  # the forkserver and two workers
+        workers = _descendants(child.pid)
+        time.sleep(0.05)
+    time.sleep(1.0)  # at work
+    assert child.poll() is None and len(workers) >= 3
+    child.send_signal(signal.SIGKILL)
+    child.wait()
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(_running(pid) for pid in workers):
+        time.sleep(0.1)
+    assert not any(_running(pid) for pid in workers)
+    assert [p.name for p in out.iterdir()] and not (out / "residues.csv").exists()  # only the staging folder
+    (tmp_path / "in2").mkdir()
+    shutil.copy(DATA / "1UBQ.pdb.gz", tmp_path / "in2")
+    assert main(["analyze", str(tmp_path / "in2"), "-o", str(out), "--jobs", "1"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["fig7.png", "residues.csv", "skipped.csv", "summary.csv"]
