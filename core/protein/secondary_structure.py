@@ -174,7 +174,7 @@ def _minimal_helices(hb: _HBonds, run: np.ndarray, n: int) -> np.ndarray:
     start = np.zeros(m, bool)
     start[1:] = turn[1:] & turn[:-1]
     helix = np.zeros(m, bool)
-    for k in range(n):
+    for k in range(min(n, m)):  # a chain shorter than the helix has none
         helix[k:] |= start[: m - k]
     return helix
 

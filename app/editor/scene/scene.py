@@ -130,9 +130,9 @@ class Scene(QObject):
         """Look at the structure along its axis of least extent (the widest view of the fold)."""
         ca = self.document.model.coords[self.document.ca_rows]
         centre = ca.mean(axis=0)
-        _, _, axes = np.linalg.svd(ca - centre, full_matrices=False)
+        _, axes = np.linalg.eigh((ca - centre).T @ (ca - centre))  # by increasing extent; any number of atoms
         renderer = self.plotter.renderer
-        renderer.camera_position = [tuple(centre + axes[2] * 100.0), tuple(centre), tuple(axes[1])]
+        renderer.camera_position = [tuple(centre + axes[:, 0] * 100.0), tuple(centre), tuple(axes[:, 1])]
         renderer.reset_camera(render=False)
         renderer.camera.zoom(1.15)
 

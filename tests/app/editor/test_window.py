@@ -4,6 +4,7 @@ Drags go through the same path as the mouse: events invoked on the VTK interacto
 ``QtInteractor`` at the display position of a control-point sphere.
 """
 
+import gzip
 from pathlib import Path
 
 import numpy as np
@@ -495,3 +496,17 @@ def test_an_empty_window_refuses_to_save(qtbot: QtBot, errors: list[str]) -> Non
     assert not window.open_file(DATA / "1BNA.pdb.gz")  # DNA only: no protein to edit
     assert "no protein chain" in errors[0]
     assert not window.save() and not window.save_as()
+
+
+@pytest.mark.parametrize("n_residues", [2, 3])
+def test_a_chain_of_two_or_three_residues_opens_and_takes_a_drag(window: MainWindow, errors: list[str],
+                                                                 tmp_path: Path, n_residues: int) -> None:
+    text = gzip.decompress((DATA / "1UBQ.pdb.gz").read_bytes()).decode()
+    lines = [line for line in text.splitlines() if line.startswith("ATOM") and int(line[22:26]) <= n_residues]
+    path = tmp_path / f"short{n_residues}.pdb"
+    path.write_text("\n".join(lines) + "\nEND\n")
+    assert window.open_file(path) and errors == []
+    assert len(window.document.ca_rows) == n_residues
+    original = window.document.model.coords.copy()
+    _drag_control_point(window, 1, (30, 20), steps=2)
+    assert window.document.undo_stack.count() == 1 and not np.array_equal(window.document.model.coords, original)
