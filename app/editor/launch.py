@@ -51,6 +51,11 @@ def open_arguments(parser: argparse.ArgumentParser) -> None:
         help="render the window to a PNG image and exit instead of running interactively",
     )
     parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the --screenshot image if it exists",
+    )
+    parser.add_argument(
         "--level",
         type=float,
         metavar="L",
@@ -91,6 +96,8 @@ def run_open(args: argparse.Namespace) -> int:
                                                                          "QT_QPA_PLATFORM"))):
         raise InputError("no display to open a window on; run under xvfb-run (scripts/ribbonwave.sh does)")
     script = _read_script(args.script) if args.script is not None else None
+    if args.screenshot is not None:
+        _check_output(args.screenshot, args.overwrite)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     window = MainWindow()
     window.unattended = script is not None or args.screenshot is not None
@@ -109,7 +116,7 @@ def run_open(args: argparse.Namespace) -> int:
     if window.isVisible() and args.screenshot is not None:
         app.processEvents()  # lay the window out before it is grabbed
         try:
-            window.save_screenshot(args.screenshot)
+            window.save_screenshot(args.screenshot, overwrite=args.overwrite)
         except OSError as error:
             window.close()
             raise InputError(str(error)) from error
@@ -165,6 +172,14 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
             raise InputError(f"--compare {spec}: {error}") from error
     if args.compare:
         window.comparison_panel.parentWidget().raise_()  # the dock listing them in front of its tab group
+
+
+def _check_output(path: Path, overwrite: bool) -> None:
+    """Refuse, before any work, an output file that exists (unless ``overwrite``) or whose folder does not."""
+    if (path.exists() or path.is_symlink()) and not overwrite:
+        raise InputError(f"{path}: refusing to overwrite an existing file (use --overwrite)")
+    if not path.parent.is_dir():
+        raise InputError(f"{path}: no such folder {path.parent}")
 
 
 def _read_script(path: Path) -> str:

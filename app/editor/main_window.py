@@ -16,7 +16,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QPoint, QSettings, Qt
+from PySide6.QtCore import QBuffer, QByteArray, QIODevice, QPoint, QSettings, Qt
 from PySide6.QtGui import (
     QAction,
     QActionGroup,
@@ -58,6 +58,7 @@ from app.editor.scene.scene import Layer, Scene
 from app.editor.scene.validation_markers import ValidationMarkers
 from app.editor.scripting import EditorAPI
 from core.protein.structure import StructureError
+from core.protein.writing import atomic_write
 
 APP_NAME = "ribbonwave"
 RECENT_KEY = "recentFiles"
@@ -226,12 +227,14 @@ class MainWindow(QMainWindow):
         elif answer == buttons.Discard:
             left[0].unlink(missing_ok=True)
 
-    def export_view(self, path: Path, width: int | None = None, height: int | None = None) -> Path:
-        """Save the 3D view as a PNG image of ``width`` x ``height`` pixels (default: the view's)."""
+    def export_view(self, path: Path, width: int | None = None, height: int | None = None, *,
+                    overwrite: bool = False) -> Path:
+        """Save the 3D view as a PNG image of ``width`` x ``height`` pixels (default: the view's),
+        atomically; an existing file only with ``overwrite`` (else FileExistsError)."""
         size = None if width is None and height is None else (width or self.plotter.width(),
                                                                height or self.plotter.height())
         self.plotter.renderer.SetUseFXAA(True)
-        self.plotter.screenshot(str(path), window_size=size)
+        write_png(_image(self.plotter.screenshot(return_img=True, window_size=size)), Path(path), overwrite=overwrite)
         return Path(path)
 
     def quit_unattended(self, discard: bool = False) -> None:
@@ -279,8 +282,10 @@ class MainWindow(QMainWindow):
             if not name:
                 return False
             path = Path(name) if name.lower().endswith(".png") else Path(name + ".png")
-        if not self._view_image().save(str(path), "PNG"):
-            QMessageBox.critical(self, APP_NAME, f"cannot write {path}")
+        try:
+            write_png(self._view_image(), path, overwrite=True)  # the dialog asked about an existing file
+        except OSError as error:
+            QMessageBox.critical(self, APP_NAME, f"cannot write {path}: {error.strerror or error}")
             return False
         return True
 
@@ -314,10 +319,10 @@ class MainWindow(QMainWindow):
             return True
         return False
 
-    def save_screenshot(self, path: Path) -> None:
-        """Render the window, 3D view included, to a PNG image (raises OSError)."""
-        if not self.grab_window().save(str(path), "PNG"):
-            raise OSError(f"cannot write {path}")
+    def save_screenshot(self, path: Path, *, overwrite: bool = False) -> None:
+        """Render the window, 3D view included, to a PNG image, atomically (raises OSError, or
+        FileExistsError for an existing file unless ``overwrite``)."""
+        write_png(self.grab_window(), Path(path), overwrite=overwrite)
 
     def grab_window(self) -> QImage:
         """An image of the whole window with the freshly rendered 3D view painted in."""
@@ -591,9 +596,28 @@ class MainWindow(QMainWindow):
 
     def _view_image(self) -> QImage:
         """The 3D view rendered now, as an image."""
-        pixels = np.ascontiguousarray(self.plotter.screenshot(return_img=True))
-        height, width = pixels.shape[:2]
-        return QImage(pixels.data, width, height, 3 * width, QImage.Format.Format_RGB888).copy()
+        return _image(self.plotter.screenshot(return_img=True))
+
+
+def _image(pixels: np.ndarray) -> QImage:
+    """An (h, w, 3) uint8 RGB array as an image."""
+    pixels = np.ascontiguousarray(pixels[..., :3])
+    height, width = pixels.shape[:2]
+    return QImage(pixels.data, width, height, 3 * width, QImage.Format.Format_RGB888).copy()
+
+
+def write_png(image: QImage, path: Path, *, overwrite: bool = False) -> None:
+    """Write ``image`` as PNG the way structures are written: to a temporary file beside
+    ``path``, then renamed onto it (never through a link); an existing ``path`` only with
+    ``overwrite`` (else FileExistsError)."""
+    if not overwrite and (path.exists() or path.is_symlink()):
+        raise FileExistsError(f"{path}: refusing to overwrite an existing file")
+    data = QByteArray()
+    buffer = QBuffer(data)
+    buffer.open(QIODevice.OpenModeFlag.WriteOnly)
+    if not image.save(buffer, "PNG"):
+        raise OSError(f"{path}: cannot encode the image")
+    atomic_write(path, bytes(data))
 
 
 def time_label(path: Path) -> str:

@@ -118,9 +118,10 @@ class EditorAPI:
         """Save the session (structure, undo history, view) to ``path`` (``.rwsession`` added if missing)."""
         return self._window.write_session(Path(path))
 
-    def screenshot(self, path: str | Path, width: int | None = None, height: int | None = None) -> Path:
+    def screenshot(self, path: str | Path, width: int | None = None, height: int | None = None, *,
+                   overwrite: bool = False) -> Path:
         """Save the 3D view as a PNG image, ``width`` x ``height`` pixels (default: the view's size)."""
-        return self._window.export_view(Path(path), width, height)
+        return self._window.export_view(Path(path), width, height, overwrite=overwrite)
 
     def quit(self, discard: bool = False) -> None:
         """Close the editor. Unsaved edits stay in the recovery journal unless ``discard``."""

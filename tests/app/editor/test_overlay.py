@@ -162,7 +162,8 @@ def test_command_line_compare_screenshot(qtbot: QtBot, tmp_path: Path, capsys: p
     status = main([str(DATA / "3PTB.pdb.gz"), "--level", "4", "--hide", "tube", "control-points",
                    "--compare", f"{PROTEASES[0]}:E", str(PROTEASES[1]), "--screenshot", str(out)])
     assert status == 0 and out.stat().st_size > 10_000
-    assert main([str(DATA / "3PTB.pdb.gz"), "--compare", f"{PROTEASES[0]}:Q", "--screenshot", str(out)]) == 1
+    other = tmp_path / "other.png"
+    assert main([str(DATA / "3PTB.pdb.gz"), "--compare", f"{PROTEASES[0]}:Q", "--screenshot", str(other)]) == 1
     assert "has no protein chain 'Q'; chains: E, I" in capsys.readouterr().err
-    assert main([str(DATA / "3PTB.pdb.gz"), "--hide", "nothing", "--screenshot", str(out)]) == 1
+    assert main([str(DATA / "3PTB.pdb.gz"), "--hide", "nothing", "--screenshot", str(other)]) == 1
     assert "--hide: no layer 'nothing'" in capsys.readouterr().err

@@ -452,7 +452,25 @@ def test_bad_level_and_unwritable_screenshot_are_one_line_errors(
     assert capsys.readouterr().err == "ribbonwave: error: --level must be >= 0; got -1\n"
     shot = tmp_path / "no-such-folder" / "shot.png"
     assert main(["--screenshot", str(shot)]) == 1
-    assert capsys.readouterr().err == f"ribbonwave: error: cannot write {shot}\n"
+    assert capsys.readouterr().err == f"ribbonwave: error: {shot}: no such folder {shot.parent}\n"
+
+
+def test_screenshot_follows_the_rules_of_output_files(qapp: QApplication, tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """Never over an existing file without --overwrite, never through a link (#16)."""
+    shot = tmp_path / "shot.png"
+    shot.write_bytes(b"mine")
+    assert main([str(DATA / "1UBQ.pdb.gz"), "--screenshot", str(shot)]) == 1
+    assert "refusing to overwrite an existing file (use --overwrite)" in capsys.readouterr().err
+    assert shot.read_bytes() == b"mine"
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    link = tmp_path / "link.png"
+    link.symlink_to(victim)
+    assert main([str(DATA / "1UBQ.pdb.gz"), "--screenshot", str(link)]) == 1
+    assert main([str(DATA / "1UBQ.pdb.gz"), "--screenshot", str(link), "--overwrite"]) == 0
+    assert victim.read_text() == "precious\n" and not link.is_symlink() and QImage(str(link)).width() == 1400
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.png", "shot.png", "victim.txt"]  # no temporary left
 
 
 def test_no_display_is_a_one_line_error(
