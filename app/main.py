@@ -20,8 +20,9 @@ from app import PROG
 from app.errors import InputError
 
 DEFAULT_COMMAND = "open"
-VECTOR_OPTIONS = ("--move",)
-"""Options whose value is a comma-separated vector that may start with a minus sign."""
+VECTOR_OPTIONS = ("--move", "--core")
+"""Options whose value may start with a minus sign: a comma-separated vector, or residue
+ranges such as ``-45--30``."""
 
 
 class Command(NamedTuple):
@@ -73,7 +74,7 @@ def _attach_negative_vectors(args: list[str]) -> list[str]:
     """Write ``--move -3,4,0`` as ``--move=-3,4,0``: argparse takes '-3,4,0' for an option."""
     glued: list[str] = []
     for arg in args:
-        if glued and glued[-1] in VECTOR_OPTIONS and re.fullmatch(r"-[0-9.][0-9.,eE+-]*", arg):
+        if glued and glued[-1] in VECTOR_OPTIONS and re.fullmatch(r"-[0-9.][0-9A-Za-z.,+-]*", arg):
             glued[-1] = f"{glued[-1]}={arg}"
         else:
             glued.append(arg)

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from app.arguments import bounded, bounded_list
 from app.cli.structure import load
 from app.errors import InputError
 from core.analysis.compare import PAIRINGS, Comparison, compare_chains
@@ -94,9 +95,9 @@ def analyze_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ss", choices=[s.value for s in SSPolicy], default="auto",
                         help="helix/sheet/other from the file's HELIX/SHEET records, else computed by DSSP (auto, "
                         "default); records: files without records count only in class 'all'")
-    parser.add_argument("--max-depth", type=float, default=AnalysisOptions.max_depth, metavar="D",
+    parser.add_argument("--max-depth", type=bounded(float, 0, 30), default=AnalysisOptions.max_depth, metavar="D",
                         help="deepest decomposition step (default %(default)g)")
-    parser.add_argument("--fraction-step", type=float, default=AnalysisOptions.fraction_step, metavar="S",
+    parser.add_argument("--fraction-step", type=bounded(float, 0.05, 30), default=AnalysisOptions.fraction_step, metavar="S",
                         help="spacing of the fractional depths (default %(default)g)")
 
 
@@ -378,11 +379,11 @@ def compare_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--core", metavar="RESIDUES",
                         help="core set as residue numbers of chain X, e.g. 5-20,31,40A (default: the pairs within "
                         "--core-cutoff after an iterative fit)")
-    parser.add_argument("--core-cutoff", type=float, default=1.0, metavar="Å",
+    parser.add_argument("--core-cutoff", type=bounded(float, 0.01, 50), default=1.0, metavar="Å",
                         help="distance cutoff of the iterative core set (default %(default)g Å)")
-    parser.add_argument("--steps", type=_int_list, default=(2, 4, 8, 16), metavar="M,...",
+    parser.add_argument("--steps", type=bounded_list(1, 1000), default=(2, 4, 8, 16), metavar="M,...",
                         help="fit on every M-th paired Cα from every offset (default 2,4,8,16)")
-    parser.add_argument("--depths", type=_int_list, default=(1, 2, 3, 4), metavar="K,...",
+    parser.add_argument("--depths", type=bounded_list(1, 16), default=(1, 2, 3, 4), metavar="K,...",
                         help="fit on the residue points C^r of the curves at level J − K (default 1,2,3,4)")
     parser.add_argument("--ribbon", choices=[k.value for k in RibbonKind], default=RibbonKind.PEPTIDE.value,
                         help="curve of the C^r fits: peptide-plane ribbon (default) or the curve through the Cα")
@@ -505,16 +506,6 @@ def _positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be >= 1; got {value}")
     return value
-
-
-def _int_list(text: str) -> tuple[int, ...]:
-    try:
-        values = tuple(int(part) for part in text.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected whole numbers separated by commas; got {text!r}") from None
-    if any(v < 1 for v in values):
-        raise argparse.ArgumentTypeError(f"numbers must be >= 1; got {text!r}")
-    return values
 
 
 def _chain_pair(text: str) -> tuple[str, str]:

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from app.arguments import LEVEL, bounded
 from app.cli.structure import chain_segments, load, segment_number
-from app.errors import InputError
 from core.protein.ribbon import RibbonKind, segment_ribbon
 
 CURVE_COLUMNS = ("chain", "segment", "resseq", "icode", "resname", "ss",
@@ -25,7 +25,7 @@ def curve_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--chain", metavar="ID", help="only this chain (default: all)")
     ribbon_argument(parser)
     parser.add_argument(
-        "--level", type=float, metavar="L",
+        "--level", type=bounded(float, *LEVEL), metavar="L",
         help="Carson level: log2 N shows the original curve (default), lower levels smoother; "
         "levels above a segment's maximum mean full resolution",
     )
@@ -34,8 +34,6 @@ def curve_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_curve(args: argparse.Namespace) -> int:
     structure = load(args.file)
-    if args.level is not None and not args.level >= 0:
-        raise InputError(f"--level must be >= 0; got {args.level:g}")
     numbers = chain_segments(structure, args.chain)
     rows = []
     for number in numbers:

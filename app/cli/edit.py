@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from app.arguments import LEVEL, bounded
 from app.cli.curve import ribbon_argument
 from app.cli.structure import chain_segments, load
 from app.errors import InputError
@@ -20,11 +21,11 @@ from core.protein.structure import BackboneSegment
 def edit_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, metavar="FILE", help="structure file (PDB or mmCIF, optionally gzipped)")
     parser.add_argument("--chain", required=True, metavar="ID", help="chain to edit")
-    parser.add_argument("--segment", type=int, default=0, metavar="S",
+    parser.add_argument("--segment", type=bounded(int, 0, 100_000), default=0, metavar="S",
                         help="segment of the chain (0-based, chains split at gaps; default 0)")
-    parser.add_argument("--level", type=float, required=True, metavar="L", help="Carson level of the edit")
+    parser.add_argument("--level", type=bounded(float, *LEVEL), required=True, metavar="L", help="Carson level of the edit")
     target = parser.add_mutually_exclusive_group(required=True)
-    target.add_argument("--point", type=int, metavar="K",
+    target.add_argument("--point", type=bounded(int, 0, 10_000_000), metavar="K",
                         help="control point to move (0-based, among those of the curve shown at L)")
     target.add_argument("--residue", metavar="RESSEQ[ICODE]", help="move the curve point of this residue instead")
     parser.add_argument("--move", required=True, type=_vector, metavar="DX,DY,DZ", help="displacement in Å")

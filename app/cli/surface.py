@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from app.arguments import bounded
 from app.errors import InputError
 from app.polydata import scalar_style, to_polydata
 from core.protein.reading import read_atoms
@@ -37,18 +38,19 @@ def surface_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--kind", choices=KINDS, default="ses",
                         help="ses: molecular surface (default); globe: sphere-topology spline surface; "
                         "dna: cylinder about the helix axis; remesh: 6·4^L triangles; map: density contour")
-    parser.add_argument("--level", type=float, metavar="L",
+    parser.add_argument("--level", type=bounded(float, 0, 10), metavar="L",
                         help="level (default the finest: 5 for globe/dna/remesh, the map's wavelet levels)")
     parser.add_argument("--color", choices=COLOURINGS, help="colour by electrostatic potential, curvature or B-factor")
     parser.add_argument("--site", metavar="LIGAND",
                         help="remesh only the patch within 10 Å of this ligand (residue name, or CHAIN:NUMBER)")
     parser.add_argument("--ideal-dna", type=int, metavar="N",
                         help=f"instead of FILE, an ideal B-DNA of N base pairs ({IDEAL_DNA_REPEAT} repeated)")
-    parser.add_argument("--contour", type=float, default=1.0, metavar="SIGMA",
+    parser.add_argument("--contour", type=bounded(float, -50, 50), default=1.0, metavar="SIGMA",
                         help="map contour in rms deviations above the mean (default 1)")
-    parser.add_argument("--probe", type=float, default=1.4, metavar="Å", help="probe radius (default 1.4 Å)")
-    parser.add_argument("--spacing", type=float, metavar="Å",
-                        help="grid step of the molecular surface (default 0.5 Å, coarser for large entries)")
+    parser.add_argument("--probe", type=bounded(float, 0, 5), default=1.4, metavar="Å",
+                        help="probe radius (default 1.4 Å, at most 5)")
+    parser.add_argument("--spacing", type=bounded(float, 0.2, 5), metavar="Å",
+                        help="grid step of the molecular surface, 0.2 to 5 Å (default 0.5 Å, coarser for large entries)")
     parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
                         help="output file: .vtp, .ply or .png")
     parser.add_argument("--overwrite", action="store_true", help="replace OUT if it exists")
@@ -58,8 +60,10 @@ def run_surface(args: argparse.Namespace) -> int:
     suffix = args.output.suffix.lower()
     if suffix not in OUTPUTS:
         raise InputError(f"{args.output}: unknown output type; use {', '.join(OUTPUTS)}")
-    if args.output.exists() and not args.overwrite:
+    if (args.output.exists() or args.output.is_symlink()) and not args.overwrite:
         raise InputError(f"{args.output}: refusing to overwrite an existing file (use --overwrite)")
+    if not args.output.parent.is_dir():
+        raise InputError(f"{args.output}: no such folder {args.output.parent}")
     if (args.file is None) == (args.ideal_dna is None):
         raise InputError("give either FILE or --ideal-dna N")
     if args.site is not None and args.kind != "remesh":

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from app import DEFAULT_STRUCTURE, PROG
+from app.arguments import LEVEL, bounded
 from app.errors import InputError
 from core.protein.structure import StructureError
 
@@ -57,7 +58,7 @@ def open_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--level",
-        type=float,
+        type=bounded(float, *LEVEL),
         metavar="L",
         help="start at this level (0 .. log2 N; default: about two levels below full resolution)",
     )
@@ -90,8 +91,6 @@ def run_open(args: argparse.Namespace) -> int:
 
     from app.editor.main_window import MainWindow
 
-    if args.level is not None and not args.level >= 0:
-        raise InputError(f"--level must be >= 0; got {args.level:g}")
     if sys.platform.startswith("linux") and not any(map(os.environ.get, ("DISPLAY", "WAYLAND_DISPLAY",
                                                                          "QT_QPA_PLATFORM"))):
         raise InputError("no display to open a window on; run under xvfb-run (scripts/ribbonwave.sh does)")

@@ -134,7 +134,6 @@ def test_edit_never_overwrites_without_asking(capsys, tmp_path):
         (["info", "missing.pdb"], "no such file"),
         (["info", DATA / "1BNA.pdb.gz"], "no protein chain"),
         (["curve", DATA / "1UBQ.pdb.gz", "--chain", "Z"], "no protein chain 'Z'"),
-        (["curve", DATA / "1UBQ.pdb.gz", "--level", "-1"], "--level must be >= 0"),
         (["edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "3", "--point", "99", "--move", "1,0,0", "-o", "x.pdb"],
          "index must be an integer in \\[0, 10\\]"),
         (["edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--segment", "3", "--level", "3", "--point", "1", "--move",

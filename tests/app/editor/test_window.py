@@ -448,8 +448,10 @@ def test_unreadable_file_is_a_one_line_error(
 def test_bad_level_and_unwritable_screenshot_are_one_line_errors(
     qapp: QApplication, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["--level", "-1"]) == 1
-    assert capsys.readouterr().err == "ribbonwave: error: --level must be >= 0; got -1\n"
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--level", "-1"])
+    assert exit_info.value.code == 2
+    assert capsys.readouterr().err.endswith("ribbonwave open: error: argument --level: must lie in [0, 30]; got -1\n")
     shot = tmp_path / "no-such-folder" / "shot.png"
     assert main(["--screenshot", str(shot)]) == 1
     assert capsys.readouterr().err == f"ribbonwave: error: {shot}: no such folder {shot.parent}\n"

@@ -1,0 +1,40 @@
+"""Argument types with their sane ranges, for every command: a value outside is a usage error
+(exit status 2) whose message gives the range, before any work starts."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable
+
+LEVEL = (0.0, 30.0)
+"""Carson levels: log2 of a segment's residues stays far below 30."""
+
+
+def bounded(kind: type, low: float, high: float) -> Callable[[str], float | int]:
+    """An argparse type: a finite ``kind`` (int or float) in ``[low, high]``."""
+    def parse(text: str) -> float | int:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a {'whole ' if kind is int else ''}number; got {text!r}") \
+                from None
+        if not (math.isfinite(value) and low <= value <= high):
+            raise argparse.ArgumentTypeError(f"must lie in [{low:g}, {high:g}]; got {text}")
+        return value
+    parse.__name__ = kind.__name__  # argparse names the type in its messages
+    return parse
+
+
+def bounded_list(low: int, high: int) -> Callable[[str], tuple[int, ...]]:
+    """An argparse type: whole numbers in ``[low, high]`` separated by commas."""
+    def parse(text: str) -> tuple[int, ...]:
+        try:
+            values = tuple(int(part) for part in text.split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected whole numbers separated by commas; got {text!r}") from None
+        if not all(low <= v <= high for v in values):
+            raise argparse.ArgumentTypeError(f"numbers must lie in [{low}, {high}]; got {text!r}")
+        return values
+    parse.__name__ = "list"
+    return parse
