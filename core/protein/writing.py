@@ -26,6 +26,10 @@ _PDB_HEADER_ORDER = (
     "SHEET", "SSBOND", "LINK", "CISPEP", "SITE", "CRYST1", "ORIGX1", "ORIGX2", "ORIGX3",
     "SCALE1", "SCALE2", "SCALE3", "MTRIX1", "MTRIX2", "MTRIX3",
 )  # fmt: skip
+_SAME_RANK = {"DBREF2": "DBREF1", "ORIGX2": "ORIGX1", "ORIGX3": "ORIGX1", "SCALE2": "SCALE1", "SCALE3": "SCALE1",
+              "MTRIX2": "MTRIX1", "MTRIX3": "MTRIX1"}
+# Records of several lines that alternate (an operator's three rows, a chain's two DBREF
+# lines) rank as one record, so that the sort, which is stable, keeps them in the input order.
 
 
 
@@ -130,7 +134,7 @@ def _pdb_text(st: gemmi.Structure, structure: Structure) -> str:
 def _with_input_header(written: str, original: str) -> str:
     """Insert into gemmi's PDB output the header records of the input of a type gemmi did
     not write (COMPND, SOURCE, AUTHOR, REVDAT, JRNL, FORMUL, SITE, ...), in standard order."""
-    rank = {record: k for k, record in enumerate(_PDB_HEADER_ORDER)}
+    rank = {record: _PDB_HEADER_ORDER.index(_SAME_RANK.get(record, record)) for record in _PDB_HEADER_ORDER}
     lines = written.splitlines()
     n_header = next(
         (k for k, line in enumerate(lines) if _record(line) in _COORDINATE_RECORDS), len(lines)

@@ -386,3 +386,29 @@ def test_write_rejects_bad_arguments(tmp_path: Path) -> None:
     with pytest.raises(StructureError, match="unknown extension"):
         write_structure(s, s.coords, tmp_path / "a.xyz")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_ncs_operators_and_other_multi_line_records_keep_their_order(tmp_path: Path) -> None:
+    """MTRIX1-3 of each operator (and ORIGX, SCALE, DBREF1/2) stay together, in input order (#16)."""
+    text = gzip.decompress((DATA / "1UBQ.pdb.gz").read_bytes()).decode()
+    rng = np.random.default_rng(4)
+    operators = []
+    for serial in range(1, 8):
+        rotation = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+        rotation *= np.sign(np.linalg.det(rotation))
+        shift = rng.normal(scale=30, size=3)
+        operators.append((rotation, shift))
+        operators_lines = [f"MTRIX{row + 1} {serial:3d}{rotation[row, 0]:10.6f}{rotation[row, 1]:10.6f}"
+                           f"{rotation[row, 2]:10.6f}     {shift[row]:10.5f}    1" for row in range(3)]
+        text = text.replace("ATOM      1 ", "\n".join(operators_lines) + "\nATOM      1 ", 1)
+    path = tmp_path / "ncs.pdb"
+    path.write_text(text)
+    out = write_structure(read_structure(path), read_structure(path).coords, tmp_path / "out.pdb")
+    records = ("MTRIX", "ORIGX", "SCALE")
+    assert ([line.rstrip() for line in out.read_text().splitlines() if line.startswith(records)]
+            == [line.rstrip() for line in text.splitlines() if line.startswith(records)])
+    ncs = gemmi.read_structure(str(out)).ncs
+    assert len(ncs) == 7
+    for op, (rotation, shift) in zip(ncs, operators, strict=True):
+        assert np.allclose(op.tr.mat.tolist(), rotation, atol=1e-6) and np.allclose(op.tr.vec.tolist(), shift, atol=1e-5)
+        assert np.linalg.det(op.tr.mat.tolist()) == pytest.approx(1.0, abs=1e-5)
