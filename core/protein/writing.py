@@ -26,6 +26,10 @@ _PDB_HEADER_ORDER = (
     "SHEET", "SSBOND", "LINK", "CISPEP", "SITE", "CRYST1", "ORIGX1", "ORIGX2", "ORIGX3",
     "SCALE1", "SCALE2", "SCALE3", "MTRIX1", "MTRIX2", "MTRIX3",
 )  # fmt: skip
+PDB_COORDINATE_RANGE = (-999.9995, 9999.9995)
+"""Å: what the ``%8.3f`` coordinate columns of PDB atom records can hold."""
+PDB_VALUE_RANGE = (-99.995, 999.995)
+"""What the ``%6.2f`` occupancy and B-factor columns can hold."""
 _SAME_RANK = {"DBREF2": "DBREF1", "ORIGX2": "ORIGX1", "ORIGX3": "ORIGX1", "SCALE2": "SCALE1", "SCALE3": "SCALE1",
               "MTRIX2": "MTRIX1", "MTRIX3": "MTRIX1"}
 # Records of several lines that alternate (an operator's three rows, a chain's two DBREF
@@ -76,6 +80,8 @@ def write_structure(
     path = Path(path)
     coords = _checked_coords(structure, coords)
     fmt, compress = _output_format(path)
+    if fmt == "pdb":
+        _check_pdb_columns(structure, coords, path)
     if not overwrite and path.exists():
         same = structure.path.exists() and path.samefile(structure.path)
         raise FileExistsError(
@@ -99,6 +105,24 @@ def _checked_coords(structure: Structure, coords: NDArray[np.float64]) -> np.nda
     if not np.isfinite(coords).all():
         raise StructureError(f"coords contains {int((~np.isfinite(coords)).sum())} non-finite value(s)")
     return coords
+
+
+def _check_pdb_columns(structure: Structure, coords: np.ndarray, path: Path) -> None:
+    """Refuse values that the fixed columns of PDB atom records cannot hold (they would be
+    written cut off or as other numbers)."""
+    for name, values, (low, high), holds in (
+        ("coordinate", coords, PDB_COORDINATE_RANGE, "-999.999 to 9999.999 Å"),
+        ("B-factor", structure.atoms.b_factor, PDB_VALUE_RANGE, "-99.99 to 999.99"),
+        ("occupancy", structure.atoms.occupancy, PDB_VALUE_RANGE, "-99.99 to 999.99"),
+    ):
+        bad = np.flatnonzero(np.any((values < low) | (values > high), axis=-1) if values.ndim > 1
+                             else (values < low) | (values > high))
+        if len(bad):
+            value = np.asarray(values[bad[0]]).ravel()
+            shown = value[np.argmax((value < low) | (value > high))]
+            raise StructureError(f"{path}: {len(bad)} atom(s) have a {name} that PDB columns cannot hold "
+                                 f"(e.g. atom {bad[0] + 1}: {shown:g}; PDB holds {holds}); "
+                                 "write mmCIF (.cif) instead")
 
 
 def _output_format(path: Path) -> tuple[str, bool]:

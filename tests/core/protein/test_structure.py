@@ -412,3 +412,27 @@ def test_ncs_operators_and_other_multi_line_records_keep_their_order(tmp_path: P
     for op, (rotation, shift) in zip(ncs, operators, strict=True):
         assert np.allclose(op.tr.mat.tolist(), rotation, atol=1e-6) and np.allclose(op.tr.vec.tolist(), shift, atol=1e-5)
         assert np.linalg.det(op.tr.mat.tolist()) == pytest.approx(1.0, abs=1e-5)
+
+
+@pytest.mark.parametrize("column, value", [("x", 1e6), ("x", 6.7e29), ("x", -1000.0), ("b", 1e30), ("b", 1000.0)])
+def test_values_pdb_columns_cannot_hold_are_refused(tmp_path: Path, column: str, value: float) -> None:
+    """PDB writes cut off or scramble them; mmCIF holds them (#16)."""
+    s = read_structure(DATA / "1UBQ.pdb.gz")
+    coords = s.coords.copy()
+    if column == "x":
+        coords[10, 0] = value
+    else:  # the first atom's B-factor, in an mmCIF
+        cif = write_structure(s, s.coords, tmp_path / "b.cif")
+        doc = gemmi.cif.read(str(cif))
+        doc[0].find("_atom_site.", ["B_iso_or_equiv"])[0][0] = f"{value:g}"
+        doc.write_file(str(cif))
+        s = read_structure(cif)
+        coords = s.coords
+    with pytest.raises(StructureError, match="PDB columns cannot hold.*write mmCIF"):
+        write_structure(s, coords, tmp_path / "out.pdb")
+    assert not (tmp_path / "out.pdb").exists()
+    back = read_structure(write_structure(s, coords, tmp_path / "out.cif"))
+    if column == "x":
+        assert back.coords[10, 0] == pytest.approx(value, rel=1e-6)
+    else:
+        assert back.atoms.b_factor[0] == pytest.approx(value, rel=1e-6)
