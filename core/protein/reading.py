@@ -52,7 +52,7 @@ def read_structure(path: str | os.PathLike[str], data: bytes | None = None) -> S
         coordinates; the message names the file.
     """
     path = Path(path)
-    text, fmt, st, atoms = _read_model(path, read_bytes(path) if data is None else data)
+    text, encoding, fmt, st, atoms = _read_model(path, read_bytes(path) if data is None else data)
     notes: list[str] = []
     groups = residue_groups(atoms)
     runs = backbone_runs(atoms, groups, notes)
@@ -81,6 +81,7 @@ def read_structure(path: str | os.PathLike[str], data: bytes | None = None) -> S
         atoms=_atom_table(st.name, atoms),
         _template=st,
         _text=text,
+        _encoding=encoding,
     )
 
 
@@ -95,13 +96,13 @@ def read_atoms(path: str | os.PathLike[str]) -> AtomTable:
         Missing, empty or unreadable file, no atoms, or non-finite coordinates.
     """
     path = Path(path)
-    _, _, st, atoms = _read_model(path, read_bytes(path))
+    _, _, _, st, atoms = _read_model(path, read_bytes(path))
     return _atom_table(st.name, atoms)
 
 
-def _read_model(path: Path, data: bytes) -> tuple[str, str, gemmi.Structure, ScannedModel]:
-    """Text, format, parsed structure and scanned first model of a file with finite atoms."""
-    text = _text(path, data)
+def _read_model(path: Path, data: bytes) -> tuple[str, str, str, gemmi.Structure, ScannedModel]:
+    """Text, its encoding, format, parsed structure and scanned first model of a file with finite atoms."""
+    text, encoding = _text(path, data)
     fmt = "mmcif" if _looks_like_mmcif(text) else "pdb"
     st = _parse(text, fmt, path)
     atoms = scan_model(st[0])
@@ -110,7 +111,7 @@ def _read_model(path: Path, data: bytes) -> tuple[str, str, gemmi.Structure, Sca
     if not np.isfinite(atoms.coords).all():
         bad = int((~np.isfinite(atoms.coords).all(axis=1)).sum())
         raise StructureError(f"{path}: {bad} atom(s) have non-finite coordinates")
-    return text, fmt, st, atoms
+    return text, encoding, fmt, st, atoms
 
 
 def _atom_table(entry_id: str, atoms: ScannedModel) -> AtomTable:
@@ -151,8 +152,9 @@ def read_bytes(path: str | os.PathLike[str]) -> bytes:
         raise StructureError(f"{path}: cannot read ({exc.strerror})") from None
 
 
-def _text(path: Path, data: bytes) -> str:
-    """File content as text, gunzipped when it starts with the gzip magic bytes."""
+def _text(path: Path, data: bytes) -> tuple[str, str]:
+    """File content as text, gunzipped when it starts with the gzip magic bytes, and the
+    encoding that gives back its bytes: UTF-8, else Latin-1 (every byte is a character)."""
     if data[:2] == b"\x1f\x8b":
         try:
             data = gzip.decompress(data)
@@ -161,9 +163,9 @@ def _text(path: Path, data: bytes) -> str:
     if not data.strip():
         raise StructureError(f"{path}: empty file")
     try:
-        return data.decode("utf-8")
+        return data.decode("utf-8"), "utf-8"
     except UnicodeDecodeError:
-        return data.decode("latin-1")
+        return data.decode("latin-1"), "latin-1"
 
 
 def _looks_like_mmcif(text: str) -> bool:

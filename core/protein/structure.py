@@ -205,6 +205,8 @@ class Structure:
     atoms: AtomTable
     _template: gemmi.Structure = field(repr=False)
     _text: str = field(repr=False)
+    _encoding: str = field(default="utf-8", repr=False)
+    """How ``_text`` was decoded: writing encodes the same way, so unchanged bytes stay as read."""
 
     @property
     def n_atoms(self) -> int:

@@ -93,7 +93,7 @@ def write_structure(
         text = _pdb_text(st, structure) if fmt == "pdb" else _mmcif_text(st, structure)
     except RuntimeError as exc:
         raise StructureError(f"{path}: cannot write {fmt.upper()} ({exc})") from None
-    data = text.encode()
+    data = text.encode(structure._encoding)
     atomic_write(path, gzip.compress(data, mtime=0) if compress else data)
     return path
 

@@ -436,3 +436,21 @@ def test_values_pdb_columns_cannot_hold_are_refused(tmp_path: Path, column: str,
         assert back.coords[10, 0] == pytest.approx(value, rel=1e-6)
     else:
         assert back.atoms.b_factor[0] == pytest.approx(value, rel=1e-6)
+
+
+@pytest.mark.parametrize("suffix", [".pdb", ".cif"])
+def test_header_bytes_that_are_not_utf8_are_written_as_read(tmp_path: Path, suffix: str) -> None:
+    """A Latin-1 byte (\\xcd) in a header line comes back as that byte, not re-encoded (#16)."""
+    s = read_structure(DATA / "1UBQ.pdb.gz")
+    source = write_structure(s, s.coords, tmp_path / f"source{suffix}")
+    data = source.read_bytes()
+    if suffix == ".pdb":
+        line = b"COMPND    MOL_ID: 1; MOLECULE: CAF\xcd;"
+        data = data.replace(b"COMPND ", line + b"\nCOMPND ", 1) if b"COMPND " in data else line + b"\n" + data
+    else:
+        line = b"_local_note.text 'CAF\xcd'"  # a category of the input: written as it was
+        data = data.replace(b"_entry.id 1UBQ\n", b"_entry.id 1UBQ\n" + line + b"\n", 1)
+    source.write_bytes(data)
+    assert line in source.read_bytes()
+    out = write_structure(read_structure(source), read_structure(source).coords, tmp_path / f"out{suffix}")
+    assert line in out.read_bytes() and "\u00cd".encode() not in out.read_bytes()
