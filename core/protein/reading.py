@@ -105,7 +105,10 @@ def _read_model(path: Path, data: bytes) -> tuple[str, str, str, gemmi.Structure
     text, encoding = _text(path, data)
     fmt = "mmcif" if _looks_like_mmcif(text) else "pdb"
     st = _parse(text, fmt, path)
-    atoms = scan_model(st[0])
+    try:
+        atoms = scan_model(st[0])
+    except (TypeError, ValueError, RuntimeError) as exc:  # e.g. a residue gemmi left without a number
+        raise StructureError(f"{path}: cannot read the atoms ({exc})") from None
     if len(atoms.coords) == 0:
         raise StructureError(f"{path}: not a structure file (no atoms found)")
     if not np.isfinite(atoms.coords).all():
@@ -179,9 +182,13 @@ def _looks_like_mmcif(text: str) -> bool:
 
 def _parse(text: str, fmt: str, path: Path) -> gemmi.Structure:
     """gemmi.Structure of ``text`` with entities set up and ``name`` set to the entry id."""
+    if fmt == "pdb":
+        _check_coordinate_fields(text, path)
     try:
         if fmt == "mmcif":
-            st = gemmi.make_structure_from_block(gemmi.cif.read_string(text)[0])
+            block = gemmi.cif.read_string(text)[0]
+            _fill_author_columns(block)
+            st = gemmi.make_structure_from_block(block)
         else:
             st = gemmi.read_pdb_string(text)
     except (RuntimeError, ValueError, IndexError) as exc:
@@ -192,6 +199,52 @@ def _parse(text: str, fmt: str, path: Path) -> gemmi.Structure:
     st.setup_entities()
     st.name = _info(st, "_entry.id") or path.name.split(".")[0]
     return st
+
+
+def _check_coordinate_fields(text: str, path: Path) -> None:
+    """Refuse a PDB atom record whose x, y or z (columns 31-54) is not a number: gemmi would
+    read it as 0.000, and every command would compute on an invented position."""
+    for number, line in enumerate(text.splitlines(), start=1):
+        if line.startswith(("ATOM  ", "HETATM")):
+            for start, axis in ((30, "x"), (38, "y"), (46, "z")):
+                field = line[start : start + 8]
+                try:
+                    float(field)
+                except ValueError:
+                    raise StructureError(f"{path}: line {number}: the {axis} coordinate {field.strip()!r} "
+                                         f"(columns {start + 1}-{start + 8}) is not a number") from None
+
+
+_LABEL_OF = {"auth_asym_id": "label_asym_id", "auth_comp_id": "label_comp_id", "auth_atom_id": "label_atom_id"}
+
+
+def _fill_author_columns(block: gemmi.cif.Block) -> None:
+    """Author columns of ``_atom_site`` that a file lacks, taken from its ``label_*`` columns
+    (what the author numbering is, when there is none). A residue without ``label_seq_id``
+    (ligands, waters) is numbered within its ``label_asym_id`` in file order: a new one starts
+    where the chemical component changes or an atom name comes again."""
+    table = block.get_mmcif_category("_atom_site.")
+    if not table or all(tag in table for tag in ("auth_seq_id", *_LABEL_OF)):
+        return
+    for auth, label in _LABEL_OF.items():
+        if auth not in table and label in table:
+            table[auth] = list(table[label])
+    if "auth_seq_id" not in table and "label_seq_id" in table:
+        numbers, seen, previous, counter = [], set(), None, {}
+        for asym, seq, comp, atom, alt in zip(table["label_asym_id"], table["label_seq_id"], table["label_comp_id"],
+                                              table["label_atom_id"], table.get("label_alt_id") or
+                                              [None] * len(table["label_seq_id"]), strict=True):
+            if seq is not None and seq is not False:
+                numbers.append(seq)
+                continue
+            key = (asym, comp)
+            if key != previous or (atom, alt) in seen:
+                counter[asym] = counter.get(asym, 0) + 1
+                seen, previous = set(), key
+            seen.add((atom, alt))
+            numbers.append(str(counter[asym]))
+        table["auth_seq_id"] = numbers
+    block.set_mmcif_category("_atom_site.", table)
 
 
 def _info(st: gemmi.Structure, key: str) -> str:

@@ -454,3 +454,42 @@ def test_header_bytes_that_are_not_utf8_are_written_as_read(tmp_path: Path, suff
     assert line in source.read_bytes()
     out = write_structure(read_structure(source), read_structure(source).coords, tmp_path / f"out{suffix}")
     assert line in out.read_bytes() and "\u00cd".encode() not in out.read_bytes()
+
+
+def _without_atom_site_columns(source: Path, path: Path, drop: object) -> Path:
+    doc = gemmi.cif.read(str(source))
+    table = doc[0].get_mmcif_category("_atom_site.")
+    for tag in [tag for tag in table if drop(tag)]:
+        del table[tag]
+    doc[0].set_mmcif_category("_atom_site.", table)
+    doc.write_file(str(path))
+    return path
+
+
+@pytest.mark.parametrize("drop", ["auth_seq_id", "every auth_ column"])
+def test_mmcif_without_author_columns_falls_back_to_the_label_columns(tmp_path: Path, drop: str) -> None:
+    """1LCD (protein, DNA, waters) with its author numbering removed reads by the label_* columns (#16)."""
+    path = _without_atom_site_columns(DATA / "1LCD.cif.gz", tmp_path / "noauth.cif",
+                                      (lambda tag: tag == "auth_seq_id") if drop == "auth_seq_id"
+                                      else (lambda tag: tag.startswith("auth_")))
+    full, s = read_structure(DATA / "1LCD.cif.gz"), read_structure(path)
+    assert s.n_atoms == full.n_atoms and np.array_equal(s.coords, full.coords)
+    assert [len(seg) for seg in s.segments] == [len(seg) for seg in full.segments]
+    assert s.segments[0].labels[0].endswith("MET1")
+    residues = [len(np.unique(x.atoms.residue[x.atoms.category == "water"])) for x in (s, full)]
+    assert residues[0] == residues[1] > 10  # each water its own residue, as with the author numbers
+    back = read_structure(write_structure(s, s.coords, tmp_path / "out.cif"))
+    assert np.array_equal(back.coords, s.coords)
+
+
+@pytest.mark.parametrize("field, axis", [("  abc.de", "x"), ("        ", "y"), ("1.2.3   ", "z")])
+def test_a_coordinate_that_is_not_a_number_is_refused(tmp_path: Path, field: str, axis: str) -> None:
+    """gemmi reads such a field as 0.000: the reader names the line instead (#16)."""
+    lines = gzip.decompress((DATA / "1UBQ.pdb.gz").read_bytes()).decode().splitlines()
+    k = next(i for i, line in enumerate(lines) if line.startswith("ATOM")) + 5
+    start = {"x": 30, "y": 38, "z": 46}[axis]
+    lines[k] = lines[k][:start] + field + lines[k][start + 8 :]
+    path = tmp_path / "bad.pdb"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(StructureError, match=rf"line {k + 1}: the {axis} coordinate .* is not a number"):
+        read_structure(path)
