@@ -22,6 +22,8 @@ from core.protein.structure import StructureError
 if TYPE_CHECKING:
     from app.editor.main_window import MainWindow
 
+MAX_SCRIPT_BYTES = 16 * 2**20
+
 
 def open_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
@@ -182,6 +184,10 @@ def _check_output(path: Path, overwrite: bool) -> None:
 
 
 def _read_script(path: Path) -> str:
+    if path.exists() and not path.is_file():
+        raise InputError(f"--script {path}: not a regular file")
+    if path.is_file() and path.stat().st_size > MAX_SCRIPT_BYTES:
+        raise InputError(f"--script {path}: more than {MAX_SCRIPT_BYTES // 2**20} MiB: not a script")
     try:
         return path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:

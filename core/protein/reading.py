@@ -10,7 +10,9 @@ inside ``Structure``.
 from __future__ import annotations
 
 import gzip
+import io
 import os
+import stat
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +30,9 @@ from core.protein.segments import (
 )  # fmt: skip
 from core.protein.structure import AtomTable, Structure, StructureError, frozen
 
+MAX_INPUT_MB = 4096
+"""MiB a structure file may hold, decompressed (the largest PDB entries hold a few hundred)."""
+LIMIT_VARIABLE = "RIBBONWAVE_MAX_INPUT_MB"
 _BACKBONE = ("N", "CA", "C", "O")
 _PEPTIDE = (gemmi.PolymerType.PeptideL, gemmi.PolymerType.PeptideD)
 
@@ -143,26 +148,54 @@ def _atom_table(entry_id: str, atoms: ScannedModel) -> AtomTable:
 
 
 def read_bytes(path: str | os.PathLike[str]) -> bytes:
-    """The content of a structure file as stored (gzipped or not); raises StructureError."""
+    """The content of a structure file as stored (gzipped or not); raises StructureError for
+    anything but a regular file (a device or FIFO is never read) or one over :func:`input_limit`."""
     path = Path(path)
-    if not path.exists():
-        raise StructureError(f"{path}: no such file")
-    if path.is_dir():
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise StructureError(f"{path}: no such file") from None
+    except OSError as exc:
+        raise StructureError(f"{path}: cannot read ({exc.strerror})") from None
+    if stat.S_ISDIR(info.st_mode):
         raise StructureError(f"{path}: is a directory, not a structure file")
+    if not stat.S_ISREG(info.st_mode):
+        raise StructureError(f"{path}: not a regular file (a device, FIFO or socket is not read)")
+    if info.st_size > input_limit():
+        raise StructureError(f"{path}: {info.st_size / 2**20:.0f} MiB is more than the input limit "
+                             f"({_limit_text()})")
     try:
         return path.read_bytes()
     except OSError as exc:
         raise StructureError(f"{path}: cannot read ({exc.strerror})") from None
 
 
+def input_limit() -> int:
+    """Bytes a structure file may hold, decompressed: ``$RIBBONWAVE_MAX_INPUT_MB`` MiB
+    (default :data:`MAX_INPUT_MB`)."""
+    try:
+        return int(float(os.environ.get(LIMIT_VARIABLE, MAX_INPUT_MB)) * 2**20)
+    except ValueError:
+        raise StructureError(f"${LIMIT_VARIABLE} must be a number of MiB; got "
+                             f"{os.environ[LIMIT_VARIABLE]!r}") from None
+
+
+def _limit_text() -> str:
+    return f"{input_limit() / 2**20:g} MiB; set ${LIMIT_VARIABLE} to raise it"
+
+
 def _text(path: Path, data: bytes) -> tuple[str, str]:
     """File content as text, gunzipped when it starts with the gzip magic bytes, and the
     encoding that gives back its bytes: UTF-8, else Latin-1 (every byte is a character)."""
     if data[:2] == b"\x1f\x8b":
+        limit = input_limit()
         try:
-            data = gzip.decompress(data)
+            with gzip.GzipFile(fileobj=io.BytesIO(data)) as stream:
+                data = stream.read(limit + 1)  # never more than the limit in memory
         except (OSError, EOFError, zlib.error) as exc:
             raise StructureError(f"{path}: corrupt gzip file ({exc})") from None
+        if len(data) > limit:
+            raise StructureError(f"{path}: decompresses to more than the input limit ({_limit_text()})")
     if not data.strip():
         raise StructureError(f"{path}: empty file")
     try:

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import gzip
+import os
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -493,3 +496,38 @@ def test_a_coordinate_that_is_not_a_number_is_refused(tmp_path: Path, field: str
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(StructureError, match=rf"line {k + 1}: the {axis} coordinate .* is not a number"):
         read_structure(path)
+
+
+@pytest.mark.parametrize("device", ["/dev/zero", "/dev/urandom"])
+def test_devices_and_fifos_are_never_read(tmp_path: Path, device: str) -> None:
+    with pytest.raises(StructureError, match="not a regular file"):
+        read_structure(device)
+    fifo = tmp_path / "fifo.pdb"
+    os.mkfifo(fifo)
+    with pytest.raises(StructureError, match="not a regular file"):
+        read_structure(fifo)  # would block for ever if opened
+
+
+def test_a_gzip_bomb_stops_at_the_input_limit_within_bounded_memory(tmp_path: Path) -> None:
+    """29 MB of gzip that inflate to 6.25 GiB, read under a 1.5 GiB address-space limit (#16)."""
+    member = gzip.compress(b"\0" * 2**26, compresslevel=1)  # 64 MiB of zeros in 0.3 MB
+    bomb = tmp_path / "bomb.pdb.gz"
+    bomb.write_bytes(member * 100)
+    script = ("import resource; resource.setrlimit(resource.RLIMIT_AS, (3 * 2**29, 3 * 2**29)); "
+              "import sys; from core.protein.reading import read_structure\n"
+              "try:\n    read_structure(sys.argv[1])\nexcept Exception as error:\n    print(error)")
+    result = subprocess.run([sys.executable, "-c", script, str(bomb)], capture_output=True, text=True, timeout=120,
+                            env={**os.environ, "RIBBONWAVE_MAX_INPUT_MB": "512"})
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert "decompresses to more than the input limit (512 MiB; set $RIBBONWAVE_MAX_INPUT_MB" in result.stdout
+
+
+def test_the_input_limit_can_be_raised_or_lowered(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("RIBBONWAVE_MAX_INPUT_MB", "0.01")  # 10 kB: 1UBQ is more
+    with pytest.raises(StructureError, match="more than the input limit"):
+        read_structure(DATA / "1UBQ.pdb.gz")
+    monkeypatch.setenv("RIBBONWAVE_MAX_INPUT_MB", "1")
+    assert read_structure(DATA / "1UBQ.pdb.gz").n_atoms == 660
+    monkeypatch.setenv("RIBBONWAVE_MAX_INPUT_MB", "lots")
+    with pytest.raises(StructureError, match="must be a number of MiB"):
+        read_structure(DATA / "1UBQ.pdb.gz")
