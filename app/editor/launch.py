@@ -23,6 +23,8 @@ if TYPE_CHECKING:
     from app.editor.main_window import MainWindow
 
 MAX_SCRIPT_BYTES = 16 * 2**20
+WINDOWLESS_PLATFORMS = ("offscreen", "minimal", "minimalegl", "linuxfb", "vnc")
+"""Qt platforms that cannot hold the OpenGL view of the editor."""
 
 
 def open_arguments(parser: argparse.ArgumentParser) -> None:
@@ -93,9 +95,8 @@ def run_open(args: argparse.Namespace) -> int:
 
     from app.editor.main_window import MainWindow
 
-    if sys.platform.startswith("linux") and not any(map(os.environ.get, ("DISPLAY", "WAYLAND_DISPLAY",
-                                                                         "QT_QPA_PLATFORM"))):
-        raise InputError("no display to open a window on; run under xvfb-run (scripts/ribbonwave.sh does)")
+    if sys.platform.startswith("linux"):
+        _check_display()
     script = _read_script(args.script) if args.script is not None else None
     if args.screenshot is not None:
         _check_output(args.screenshot, args.overwrite)
@@ -173,6 +174,39 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
             raise InputError(f"--compare {spec}: {error}") from error
     if args.compare:
         window.comparison_panel.parentWidget().raise_()  # the dock listing them in front of its tab group
+
+
+def _check_display() -> None:
+    """Say what is wrong before Qt would abort: no display, a platform plugin Qt lacks or one
+    without OpenGL windows, or an X display that does not answer."""
+    import ctypes
+    import ctypes.util
+
+    import PySide6
+
+    platform = os.environ.get("QT_QPA_PLATFORM", "").split(":")[0]
+    if not platform and not any(map(os.environ.get, ("DISPLAY", "WAYLAND_DISPLAY"))):
+        raise InputError("no display to open a window on; run under xvfb-run (scripts/ribbonwave.sh does)")
+    if platform:
+        plugins = Path(PySide6.__file__).parent / "Qt" / "plugins" / "platforms"
+        known = sorted(p.name.removeprefix("libq").removesuffix(".so") for p in plugins.glob("libq*.so"))
+        if known and platform not in known:
+            raise InputError(f"QT_QPA_PLATFORM={platform!r} is not a Qt platform here; known: {', '.join(known)}")
+        if platform in WINDOWLESS_PLATFORMS:
+            raise InputError(f"QT_QPA_PLATFORM={platform!r} cannot show the 3D view (no OpenGL windows); "
+                             "unset it, or run under xvfb-run")
+    if platform in ("", "xcb") and os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        name = ctypes.util.find_library("X11")
+        if name is not None:
+            xlib = ctypes.CDLL(name)
+            xlib.XOpenDisplay.restype = ctypes.c_void_p
+            xlib.XOpenDisplay.argtypes = [ctypes.c_char_p]
+            handle = xlib.XOpenDisplay(os.environ["DISPLAY"].encode())
+            if not handle:
+                raise InputError(f"cannot open the display DISPLAY={os.environ['DISPLAY']!r}: no X server "
+                                 "answers there (or it refuses this user); run under xvfb-run")
+            xlib.XCloseDisplay.argtypes = [ctypes.c_void_p]
+            xlib.XCloseDisplay(handle)
 
 
 def _check_output(path: Path, overwrite: bool) -> None:

@@ -530,3 +530,18 @@ def test_a_chain_of_two_or_three_residues_opens_and_takes_a_drag(window: MainWin
     original = window.document.model.coords.copy()
     _drag_control_point(window, 1, (30, 20), steps=2)
     assert window.document.undo_stack.count() == 1 and not np.array_equal(window.document.model.coords, original)
+
+
+@pytest.mark.parametrize("name, value, message", [
+    ("DISPLAY", ":77", "cannot open the display DISPLAY=':77': no X server answers there"),
+    ("QT_QPA_PLATFORM", "bogus", "QT_QPA_PLATFORM='bogus' is not a Qt platform here; known: "),
+    ("QT_QPA_PLATFORM", "offscreen", "QT_QPA_PLATFORM='offscreen' cannot show the 3D view"),
+])
+def test_a_display_qt_cannot_use_is_a_one_line_error(qapp: QApplication, monkeypatch: pytest.MonkeyPatch,
+                                                      capsys: pytest.CaptureFixture[str], name: str, value: str,
+                                                      message: str) -> None:
+    """Said before Qt would abort the process (#16)."""
+    monkeypatch.setenv(name, value)
+    assert main([str(DATA / "1UBQ.pdb.gz")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"ribbonwave: error: {message}") and err.count("\n") == 1
