@@ -30,6 +30,8 @@ _COUPLING = 0.084 * 332.0  # kcal/mol·Å
 _MIN_ENERGY = -9.9  # kcal/mol
 _MIN_DISTANCE = 0.5  # Å: closer atoms give the floor energy
 _MAX_CA_DISTANCE = 9.0  # Å: no H-bond between residues further apart
+_CHUNK = 2048
+"""Acceptor residues whose H-bond candidates are looked at together."""
 _MAX_PEPTIDE_BOND = 2.5  # Å: a longer C(i-1)-N(i) distance is a chain break
 
 
@@ -110,21 +112,31 @@ def _amide_hydrogens(
 def _hbond_pairs(
     n: np.ndarray, ca: np.ndarray, c: np.ndarray, o: np.ndarray, h: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(acceptor C=O residue, donor N-H residue) index arrays of all H-bonds."""
+    """(acceptor C=O residue, donor N-H residue) index arrays of all H-bonds.
+
+    Candidates are the residue pairs with Cα closer than 9 Å (a k-d tree), taken
+    :data:`_CHUNK` acceptors at a time and reduced to those below the energy cutoff before
+    the next chunk, so memory stays in proportion to the chain however dense it is packed.
+    """
     finite = np.flatnonzero(np.isfinite(ca).all(axis=1))
-    pairs = finite[cKDTree(ca[finite]).query_pairs(_MAX_CA_DISTANCE, output_type="ndarray")]
-    acc = np.concatenate([pairs[:, 0], pairs[:, 1]])
-    don = np.concatenate([pairs[:, 1], pairs[:, 0]])
-    keep = (don != acc + 1) & np.isfinite(h[don]).all(axis=1)
-    acc, don = acc[keep], don[keep]
-    energy = _hbond_energy(o[acc], c[acc], n[don], h[don])
+    tree = cKDTree(ca[finite])
+    found = []
+    for start in range(0, len(finite), _CHUNK):
+        rows = finite[start : start + _CHUNK]
+        near = cKDTree(ca[rows]).sparse_distance_matrix(tree, _MAX_CA_DISTANCE, output_type="ndarray")
+        acc, don = rows[near["i"]], finite[near["j"]]
+        keep = (don != acc) & (don != acc + 1) & np.isfinite(h[don]).all(axis=1)
+        acc, don = acc[keep], don[keep]
+        energy = _hbond_energy(o[acc], c[acc], n[don], h[don])
+        below = energy < HBOND_ENERGY_CUTOFF  # only these can be bonds: the rest go now
+        found.append((acc[below], don[below], energy[below]))
+    acc, don, energy = (np.concatenate(parts) for parts in zip(*found)) if found else (np.zeros(0, int),) * 3
     # Each N-H keeps its two lowest-energy acceptors (as in DSSP).
     order = np.lexsort((energy, don))
-    acc, don, energy = acc[order], don[order], energy[order]
+    acc, don = acc[order], don[order]
     first_of_donor = np.searchsorted(don, don, side="left")
     best_two = np.arange(len(don)) - first_of_donor < 2
-    bond = best_two & (energy < HBOND_ENERGY_CUTOFF)
-    return acc[bond], don[bond]
+    return acc[best_two], don[best_two]
 
 
 def _hbond_energy(o: np.ndarray, c: np.ndarray, n: np.ndarray, h: np.ndarray) -> np.ndarray:

@@ -110,3 +110,31 @@ def test_speed_on_a_large_entry() -> None:
     start = time.perf_counter()
     dssp(**args)
     assert time.perf_counter() - start < 1.0
+
+
+DENSE = """
+import resource
+resource.setrlimit(resource.RLIMIT_AS, (2**31, 2**31))  # a crash, not a swap storm, if it runs away
+import numpy as np
+from core.protein.secondary_structure import dssp
+rng = np.random.default_rng(0)
+steps = rng.normal(size=(20_000, 3))
+ca = np.cumsum(3.8 * steps / np.linalg.norm(steps, axis=1, keepdims=True), axis=0)
+ca = 60.0 - np.abs(ca % 120.0 - 60.0)  # folded into a 60 A box: 3 million Ca pairs within 9 A
+offsets = rng.normal(scale=0.8, size=(3, 20_000, 3))
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+ss = dssp(ca + offsets[0], ca, ca + offsets[1], ca + offsets[2])
+print(len(ss), (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) // 1024)
+"""
+
+
+def test_a_dense_20000_residue_chain_needs_memory_in_proportion_to_the_chain() -> None:
+    """A crafted chain packed far denser than a protein: the H-bond search runs in chunks,
+    within 150 MB more than the arrays (all candidates at once took 310 MB here) (#16)."""
+    import subprocess
+    import sys
+
+    result = subprocess.run([sys.executable, "-c", DENSE], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-2000:]
+    residues, megabytes = map(int, result.stdout.split())
+    assert residues == 20_000 and megabytes < 150
