@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import gzip
 import os
+import re
 import tempfile
 from pathlib import Path
 
@@ -26,6 +27,10 @@ _PDB_HEADER_ORDER = (
     "SHEET", "SSBOND", "LINK", "CISPEP", "SITE", "CRYST1", "ORIGX1", "ORIGX2", "ORIGX3",
     "SCALE1", "SCALE2", "SCALE3", "MTRIX1", "MTRIX2", "MTRIX3",
 )  # fmt: skip
+_AS_READ = ("HET", "HETNAM", "HETSYN", "FORMUL")
+"""PDB records written as the input has them (gemmi reorders them; no edit changes them)."""
+_AS_READ_UNMOVED = ("SSBOND", "LINK", "CISPEP")
+"""Records with distances and angles: the input's when nothing moved, else gemmi's, recomputed."""
 PDB_COORDINATE_RANGE = (-999.9995, 9999.9995)
 """Å: what the ``%8.3f`` coordinate columns of PDB atom records can hold."""
 PDB_VALUE_RANGE = (-99.995, 999.995)
@@ -87,10 +92,14 @@ def write_structure(
         raise FileExistsError(
             f"{path}: refusing to overwrite {'the input file' if same else 'an existing file'}"
         )
-    st = structure._template.clone()
-    _set_positions(st[0], coords)
+    text = _patched_atom_site(structure._text, structure.coords, coords) if (fmt, structure.source_format) == (
+        "mmcif", "mmcif") else None
     try:
-        text = _pdb_text(st, structure) if fmt == "pdb" else _mmcif_text(st, structure)
+        if text is None:
+            st = structure._template.clone()
+            _set_positions(st[0], coords)
+            moved = not np.array_equal(coords, structure.coords)
+            text = _pdb_text(st, structure, moved) if fmt == "pdb" else _mmcif_text(st, structure)
     except RuntimeError as exc:
         raise StructureError(f"{path}: cannot write {fmt.upper()} ({exc})") from None
     data = text.encode(structure._encoding)
@@ -145,21 +154,22 @@ def _set_positions(model: gemmi.Model, coords: np.ndarray) -> None:
                 atom.pos = gemmi.Position(*next(rows))
 
 
-def _pdb_text(st: gemmi.Structure, structure: Structure) -> str:
+def _pdb_text(st: gemmi.Structure, structure: Structure, moved: bool) -> str:
     options = gemmi.PdbWriteOptions()
     options.preserve_serial = True
     options.conect_records = True
     text = st.make_pdb_string(options)
     if structure.source_format == "pdb":
-        text = _with_input_header(text, structure._text)
+        text = _with_input_header(text, structure._text, _AS_READ + (() if moved else _AS_READ_UNMOVED))
     return text
 
 
-def _with_input_header(written: str, original: str) -> str:
+def _with_input_header(written: str, original: str, as_read: tuple[str, ...] = ()) -> str:
     """Insert into gemmi's PDB output the header records of the input of a type gemmi did
-    not write (COMPND, SOURCE, AUTHOR, REVDAT, JRNL, FORMUL, SITE, ...), in standard order."""
+    not write (COMPND, SOURCE, AUTHOR, REVDAT, JRNL, FORMUL, SITE, ...), in standard order;
+    the records of the types ``as_read`` are the input's, not gemmi's."""
     rank = {record: _PDB_HEADER_ORDER.index(_SAME_RANK.get(record, record)) for record in _PDB_HEADER_ORDER}
-    lines = written.splitlines()
+    lines = [line for line in written.splitlines() if _record(line) not in as_read]
     n_header = next(
         (k for k, line in enumerate(lines) if _record(line) in _COORDINATE_RECORDS), len(lines)
     )
@@ -169,10 +179,8 @@ def _with_input_header(written: str, original: str) -> str:
         record = _record(line)
         if record in _COORDINATE_RECORDS:
             break
-        if record in rank and record not in present:
+        if record in rank and (record not in present or record in as_read):
             extra.append(line.rstrip("\r"))
-    if not extra:
-        return written
     keyed = []
     last = 0
     for line in lines[:n_header]:
@@ -188,12 +196,63 @@ def _record(line: str) -> str:
 
 
 def _mmcif_text(st: gemmi.Structure, structure: Structure) -> str:
+    """gemmi's mmCIF of ``st``: for mmCIF input, the input's categories with the atoms
+    written anew (when :func:`_patched_atom_site` cannot patch them in place)."""
     if structure.source_format != "mmcif":
         return st.make_mmcif_document().as_string()
     doc = gemmi.cif.read_string(structure._text)
     groups = gemmi.MmcifOutputGroups(False, atoms=True, group_pdb=True, auth_all=True)
     st.update_mmcif_block(doc[0], groups)
     return doc.as_string()
+
+
+_TOKEN = re.compile(r"""'[^']*'(?=\s|$)|"[^"]*"(?=\s|$)|\S+""")
+
+
+def _patched_atom_site(text: str, read: np.ndarray, coords: np.ndarray) -> str | None:
+    """The mmCIF ``text`` with only the coordinates of the first-model atoms that moved
+    rewritten, each with as many decimals as it had (3 at least): every other byte stays as
+    read. None when the ``_atom_site`` loop is not laid out one atom per line in the order
+    read (then gemmi writes the atoms)."""
+    lines = text.splitlines(keepends=True)
+    start = next((k for k, line in enumerate(lines) if line.startswith("_atom_site.")), None)
+    if start is None or start == 0 or lines[start - 1].strip() != "loop_":
+        return None
+    tags = []
+    while start + len(tags) < len(lines) and lines[start + len(tags)].startswith("_atom_site."):
+        tags.append(lines[start + len(tags)].split()[0].removeprefix("_atom_site."))
+    if not {"Cartn_x", "Cartn_y", "Cartn_z"} <= set(tags):
+        return None
+    columns = [tags.index(f"Cartn_{axis}") for axis in "xyz"]
+    first = start + len(tags)
+    stop = next((k for k in range(first, len(lines))
+                 if lines[k].startswith(("_", "loop_", "#", "data_", ";")) or not lines[k].strip()), len(lines))
+    rows = [_TOKEN.findall(line) for line in lines[first:stop]]
+    if any(len(tokens) != len(tags) for tokens in rows):
+        return None  # a row over several lines
+    if "pdbx_PDB_model_num" in tags:
+        model = tags.index("pdbx_PDB_model_num")
+        kept = [k for k, tokens in enumerate(rows) if tokens[model] == rows[0][model]] if rows else []
+    else:
+        kept = list(range(len(rows)))
+    if len(kept) != len(read):
+        return None
+    try:
+        values = np.array([[rows[k][c] for c in columns] for k in kept], dtype=np.float64).reshape(-1, 3)
+    except ValueError:
+        return None
+    if not np.allclose(values, read, rtol=0, atol=1e-6):
+        return None  # not the atoms read, in that order: leave the writing to gemmi
+    for atom in np.flatnonzero(np.any(coords != read, axis=1)):
+        k = first + kept[atom]
+        spans = [m.span() for m in _TOKEN.finditer(lines[k])]
+        line = lines[k]
+        for c, value in sorted(zip(columns, coords[atom]), reverse=True):
+            begin, end = spans[c]
+            decimals = len(line[begin:end].partition(".")[2])
+            line = line[:begin] + f"{value:.{max(decimals, 3)}f}" + line[end:]
+        lines[k] = line
+    return "".join(lines)
 
 
 def atomic_write(path: Path, data: bytes) -> None:

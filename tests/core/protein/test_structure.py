@@ -531,3 +531,68 @@ def test_the_input_limit_can_be_raised_or_lowered(tmp_path: Path, monkeypatch: p
     monkeypatch.setenv("RIBBONWAVE_MAX_INPUT_MB", "lots")
     with pytest.raises(StructureError, match="must be a number of MiB"):
         read_structure(DATA / "1UBQ.pdb.gz")
+
+
+@pytest.mark.parametrize("name", ["1LCD.cif.gz", "3JQH.cif.gz", "4YVS.cif.gz", "7Z9T.cif.gz"])
+def test_mmcif_written_unmoved_is_the_input_byte_for_byte(tmp_path: Path, name: str) -> None:
+    s = read_structure(DATA / name)
+    out = write_structure(s, s.coords, tmp_path / "out.cif")
+    assert out.read_bytes() == gzip.decompress((DATA / name).read_bytes())
+
+
+def test_mmcif_keeps_the_decimals_of_its_coordinates(tmp_path: Path) -> None:
+    """An mmCIF with 7-decimal coordinates: unmoved atoms keep their text, moved ones get 7
+    decimals too; nothing else of the file changes (#16)."""
+    doc = gemmi.cif.read(str(DATA / "7Z9T.cif.gz"))
+    table = doc[0].find("_atom_site.", ["Cartn_x", "Cartn_y", "Cartn_z"])
+    rng = np.random.default_rng(2)
+    for row in table:
+        for k in range(3):
+            row[k] = f"{float(row[k]) + rng.uniform(-4e-4, 4e-4):.7f}"
+    seven = tmp_path / "seven.cif"
+    doc.write_file(str(seven))
+    source = read_structure(seven)
+    moved = source.coords.copy()
+    moved[50:80] += [0.12345678, -1.0, 2.5]
+    out = write_structure(source, moved, tmp_path / "out.cif")
+    back = read_structure(out)
+    assert np.allclose(back.coords, moved, atol=6e-8) and np.array_equal(back.coords[:50], source.coords[:50])
+    written, before = out.read_text().splitlines(), seven.read_text().splitlines()
+    changed = [k for k, (a, b) in enumerate(zip(written, before, strict=True)) if a != b]
+    assert len(changed) == 30  # the 30 moved atoms' lines, nothing else
+    assert all(len(token.partition(".")[2]) == 7 for k in changed for token in written[k].split()[10:13])
+
+
+PROTEIN_ENTRIES = sorted(p.name for p in DATA.glob("*.gz") if p.name != "1BNA.pdb.gz")
+PDB_GROUPS = ("MTRIX", "ORIGX", "SCALE", "LINK", "SSBOND", "CISPEP", "HET")
+
+
+def _atoms(path: Path) -> list[tuple]:
+    st = gemmi.read_structure(str(path))
+    return [(m.num, ch.name, str(r.seqid), r.name, a.name, a.altloc, a.element.name, round(a.pos.x, 3),
+             round(a.pos.y, 3), round(a.pos.z, 3), round(a.occ, 2), round(a.b_iso, 2))
+            for m in st for ch in m for r in ch for a in r]
+
+
+@pytest.mark.parametrize("name", PROTEIN_ENTRIES)
+def test_an_unmoved_structure_reads_back_record_by_record(tmp_path: Path, name: str) -> None:
+    """What ``edit --move 0,0,0`` writes: the atoms of every model, the MTRIX, ORIGX, SCALE,
+    LINK, SSBOND, CISPEP and HET records of PDB input, and mmCIF input byte for byte (#16)."""
+    s = read_structure(DATA / name)
+    source = _atoms(DATA / name)
+    cif = write_structure(s, s.coords, tmp_path / "out.cif")
+    assert _atoms(cif) == source
+    if s.source_format == "mmcif":
+        assert cif.read_bytes() == gzip.decompress((DATA / name).read_bytes())
+        return
+    try:
+        pdb = write_structure(s, s.coords, tmp_path / "out.pdb")
+    except StructureError as error:
+        assert "cannot" in str(error)  # a chain id PDB cannot hold: refused, not mangled
+        return
+    assert _atoms(pdb) == source
+    original, written = text_of(name).splitlines(), pdb.read_text().splitlines()
+    for group in PDB_GROUPS:
+        def lines(text: list[str]) -> list[str]:
+            return [line.rstrip() for line in text if line[:6].strip().rstrip("123") == group]
+        assert lines(written) == lines(original), group
