@@ -20,8 +20,11 @@ import os
 import re
 import shutil
 import signal
+import socket
+import struct
 import sys
 import tempfile
+import urllib.parse
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
@@ -57,6 +60,12 @@ RESIDUE_COLUMNS = ("file", "entry", "chain", "curve", "resseq", "icode", "resnam
 OUTPUTS = ("residues.csv", "summary.csv", "skipped.csv", "fig7.png")
 STAGING_PREFIX = ".analyze-"
 """Outputs are written into a new folder ``OUTDIR/.analyze-PID-XXXXXXXX``, then moved into place."""
+DASK_TIMEOUT = 10.0
+"""Seconds to connect to a Dask scheduler and hear its greeting."""
+DASK_FRAME = struct.Struct("<Q")
+"""A Dask message starts with its length: 8 bytes, little-endian."""
+DASK_GREETING_MAX = 1 << 20
+"""Bytes a scheduler's greeting (its handshake) may take: a few hundred in practice."""
 PR_SET_PDEATHSIG = 1
 """prctl(2): the signal a process gets when its parent ends."""
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
@@ -182,16 +191,19 @@ def _run(paths: list[Path], options: AnalysisOptions, jobs: int, scheduler: str 
 def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: str
               ) -> Iterator[tuple[int, Outcome]]:
     try:
+        import dask
         from dask.distributed import Client, LocalCluster, as_completed as dask_completed
     except ImportError:
         raise InputError("--scheduler needs Dask: pip install 'dask[distributed]' (the 'cluster' extra)") from None
     with contextlib.ExitStack() as stack:
         try:
-            scheduler = address
             if address == "local":
-                scheduler = stack.enter_context(LocalCluster(n_workers=jobs, threads_per_worker=1, dashboard_address=None))
-            client = stack.enter_context(Client(scheduler, timeout=10))
-        except (OSError, ValueError) as error:
+                cluster, security = _local_cluster(stack, LocalCluster, jobs, dask)
+                client = stack.enter_context(Client(cluster, security=security, timeout=DASK_TIMEOUT))
+            else:
+                _check_scheduler(address)
+                client = stack.enter_context(Client(address, timeout=DASK_TIMEOUT))
+        except (OSError, ValueError, TimeoutError) as error:
             raise InputError(f"cannot reach the Dask scheduler {address}: {error}") from None
         futures = client.map(analyse_file, paths, options=options, pure=False)
         index = {future.key: k for k, future in enumerate(futures)}
@@ -200,6 +212,56 @@ def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: s
         for future in completed:
             k = index.pop(future.key)
             yield k, _outcome(future, paths[k])
+
+
+def _local_cluster(stack: contextlib.ExitStack, local_cluster: type, jobs: int, dask: object) -> tuple[object, object]:
+    """A cluster on this machine that only this process can use: TLS with a certificate made
+    for this run (no other user can submit tasks to it), on 127.0.0.1, with no HTTP routes
+    and the scheduler's HTTP server stopped."""
+    try:
+        from distributed.security import Security
+
+        security = Security.temporary()
+    except ImportError:
+        raise InputError("--scheduler needs the 'cryptography' package for a private local cluster: "
+                         "pip install 'ribbonwave[cluster]'") from None
+    stack.enter_context(dask.config.set({"distributed.scheduler.http.routes": [],
+                                         "distributed.worker.http.routes": []}))
+    cluster = stack.enter_context(local_cluster(
+        n_workers=jobs, threads_per_worker=1, processes=True, protocol="tls", security=security, host="127.0.0.1",
+        dashboard_address=None, worker_dashboard_address=None))
+    cluster.scheduler.http_server.stop()
+    return cluster, security
+
+
+def _check_scheduler(address: str) -> None:
+    """Refuse an address that is not ``tcp://HOST:PORT``, and a server there that does not
+    greet like a Dask scheduler within DASK_TIMEOUT (Dask would take any 8 bytes it sends
+    for the length of a message, and allocate it)."""
+    parts = urllib.parse.urlsplit(address if "://" in address else f"tcp://{address}")
+    try:
+        port = parts.port
+    except ValueError:
+        port = None
+    if parts.scheme != "tcp" or not parts.hostname or port is None or parts.path not in ("", "/"):
+        raise InputError(f"--scheduler {address}: expected tcp://HOST:PORT (a scheduler with TLS needs its "
+                         "credentials, which analyze does not take)")
+    try:
+        with socket.create_connection((parts.hostname, port), timeout=DASK_TIMEOUT) as connection:
+            connection.settimeout(DASK_TIMEOUT)
+            greeting = b""
+            while len(greeting) < DASK_FRAME.size:
+                chunk = connection.recv(DASK_FRAME.size - len(greeting))
+                if not chunk:
+                    break
+                greeting += chunk
+    except TimeoutError:
+        raise InputError(f"--scheduler {address}: the server there does not greet like a Dask scheduler "
+                         f"(nothing within {DASK_TIMEOUT:g} s)") from None
+    except OSError as error:
+        raise InputError(f"cannot reach the Dask scheduler {address}: {error.strerror or error}") from None
+    if len(greeting) < DASK_FRAME.size or not 0 < DASK_FRAME.unpack(greeting)[0] <= DASK_GREETING_MAX:
+        raise InputError(f"--scheduler {address}: the server there is not a Dask scheduler")
 
 
 def analyse_file(path: Path, options: AnalysisOptions) -> Outcome:

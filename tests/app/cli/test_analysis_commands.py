@@ -4,6 +4,7 @@ import csv
 import json
 import re
 import shutil
+import socket
 from pathlib import Path
 
 import numpy as np
@@ -104,7 +105,8 @@ def test_one_process_and_a_dask_cluster_give_the_same_numbers(database, analysed
 
     status, _, _ = run(capsys, "analyze", database, "-o", tmp_path / "serial", "--jobs", "1")
     assert status == 0
-    with LocalCluster(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None) as cluster:
+    with LocalCluster(processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None,
+                      protocol="tcp") as cluster:
         status, _, _ = run(capsys, "analyze", database, "-o", tmp_path / "dask", "--scheduler", cluster.scheduler_address)
     assert status == 0
     expected = (analysed / "summary.csv").read_text()
@@ -332,3 +334,59 @@ def test_killing_analyze_leaves_no_worker_and_the_next_run_cleans_up(tmp_path):
     shutil.copy(DATA / "1UBQ.pdb.gz", tmp_path / "in2")
     assert main(["analyze", str(tmp_path / "in2"), "-o", str(out), "--jobs", "1"]) == 0
     assert sorted(p.name for p in out.iterdir()) == ["fig7.png", "residues.csv", "skipped.csv", "summary.csv"]
+
+
+def test_the_local_cluster_is_private(tmp_path, capsys):
+    """``--scheduler`` alone: TLS with a certificate of this run, on 127.0.0.1, no HTTP server on
+    8787; a client without the credentials cannot use it (#16)."""
+    import contextlib
+
+    import dask
+    from dask.distributed import Client, LocalCluster
+
+    from app.cli.analysis import _local_cluster
+
+    with contextlib.ExitStack() as stack:
+        cluster, security = _local_cluster(stack, LocalCluster, 1, dask)
+        assert cluster.scheduler_address.startswith("tls://127.0.0.1:")
+        with socket.socket() as probe:
+            assert probe.connect_ex(("127.0.0.1", 8787)) != 0  # no dashboard or other HTTP endpoint
+        with pytest.raises((OSError, TypeError, TimeoutError)):
+            Client(cluster.scheduler_address, timeout=3)  # no credentials, no tasks
+        with Client(cluster, security=security, timeout=10) as client:
+            assert client.submit(sum, [1, 2]).result() == 3
+    status, out, _ = run(capsys, "analyze", DATA / "1UBQ.pdb.gz", "-o", tmp_path / "out", "--scheduler")
+    assert status == 0 and "analysed 1 file(s)" in out
+
+
+@pytest.mark.parametrize("address", ["http://127.0.0.1:8786", "tcp://127.0.0.1", "tcp://:8786", "tls://127.0.0.1:1",
+                                     "tcp://127.0.0.1:99999"])
+def test_a_scheduler_address_is_checked(address, tmp_path, capsys):
+    status, _, err = run(capsys, "analyze", DATA / "1UBQ.pdb.gz", "-o", tmp_path / "out", "--scheduler", address)
+    assert status == 1 and "expected tcp://HOST:PORT" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("reply, message", [(b"HTTP/1.1 400 Bad Request\r\n\r\n", "is not a Dask scheduler"),
+                                            (None, "does not greet like a Dask scheduler")])
+def test_a_server_that_is_not_a_scheduler_fails_within_the_timeout(reply, message, tmp_path, capsys, monkeypatch):
+    import threading
+    import time
+
+    monkeypatch.setattr("app.cli.analysis.DASK_TIMEOUT", 1.0)
+    server = socket.create_server(("127.0.0.1", 0))
+    held = []
+
+    def serve() -> None:
+        connection, _ = server.accept()
+        held.append(connection)
+        if reply is not None:
+            connection.sendall(reply)
+
+    threading.Thread(target=serve, daemon=True).start()
+    start = time.monotonic()
+    status, _, err = run(capsys, "analyze", DATA / "1UBQ.pdb.gz", "-o", tmp_path / "out", "--scheduler",
+                         f"tcp://127.0.0.1:{server.getsockname()[1]}")
+    assert status == 1 and message in err and time.monotonic() - start < 5
+    server.close()
+    for connection in held:
+        connection.close()
