@@ -36,6 +36,7 @@ from PySide6.QtWidgets import (
     QMessageBox,
     QScrollArea,
     QStyle,
+    QTabBar,
     QUndoView,
     QWidget,
 )
@@ -114,16 +115,16 @@ class MainWindow(QMainWindow):
                  self._dock("Undo history", self.history), self._dock("Validation", _scrolled(self.validation_panel)),
                  self._dock("Compared structures", self.comparison_panel)]
         docks.append(self._dock("Surface", self.surface_panel))
-        self.console_dock = self._dock("Python Console", self.console)
+        self.console_dock = self._dock("Python Console", self.console, Qt.DockWidgetArea.BottomDockWidgetArea)
         self.console_dock.hide()
         self.tabifyDockWidget(docks[1], docks[-1])  # beside the ribbon's display options
         docks[1].raise_()
         self.tabifyDockWidget(docks[2], docks[3])  # validation and history share a place: the window stays small
         self.tabifyDockWidget(docks[2], docks[4])  # and the compared structures
         docks[3].raise_()
+        self.console_dock.visibilityChanged.connect(self._hide_stale_tab_bars)
         self._create_actions()
         self._create_menus(docks)
-        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.console_dock)
         self._create_status_bar()
 
         self.document.fileChanged.connect(self._update_title)
@@ -359,11 +360,12 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ building
 
-    def _dock(self, title: str, widget: QWidget) -> QDockWidget:
+    def _dock(self, title: str, widget: QWidget,
+              area: Qt.DockWidgetArea = Qt.DockWidgetArea.RightDockWidgetArea) -> QDockWidget:
         dock = QDockWidget(title, self)
         dock.setObjectName(title)
         dock.setWidget(widget)
-        self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, dock)
+        self.addDockWidget(area, dock)
         return dock
 
     def _create_actions(self) -> None:
@@ -456,6 +458,16 @@ class MainWindow(QMainWindow):
         self.status_labels = {key: QLabel() for key in ("file", "segment", "level", "pick")}
         for key, label in self.status_labels.items():
             self.statusBar().addWidget(label, 1 if key == "pick" else 0)
+
+    def _hide_stale_tab_bars(self) -> None:
+        """Qt (6.11) leaves the tab bar of a two-dock group visible, under the docks, once a third
+        dock joins the group; a bottom dock uncovers it. Hide every tab bar whose tabs another
+        one shows too."""
+        bars = [bar for bar in self.findChildren(QTabBar) if bar.parent() is self]
+        tabs = {bar: {bar.tabText(k) for k in range(bar.count())} for bar in bars}
+        for bar in bars:
+            if any(other is not bar and tabs[bar] < tabs[other] for other in bars):
+                bar.hide()
 
     def _swallow_style_keys(self) -> None:
         """Keep VTK's one-letter camera-style keys ('w' wireframe, 'e' exit, ...) away from the view."""

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QImage
+from PySide6.QtWidgets import QTabBar
 from pytestqt.qtbot import QtBot
 from test_window import _drag_control_point, _window
 
@@ -122,6 +123,8 @@ def test_the_python_console_drives_the_editor(qtbot: QtBot) -> None:
     console_action = next(a for a in window.menuBar().actions()[2].menu().actions() if a.text() == "Python Console")
     console_action.trigger()
     assert window.console_dock.isVisible()
+    shown = [{bar.tabText(k) for k in range(bar.count())} for bar in window.findChildren(QTabBar) if bar.isVisible()]
+    assert not any(a < b for a in shown for b in shown)  # no stale tab bar left over by Qt above the console
     qtbot.keyClicks(window.console.input, "rw.level = 2.5")
     qtbot.keyClick(window.console.input, Qt.Key.Key_Return)
     qtbot.keyClicks(window.console.input, "rw.move(3, np.array([2.0, 0, 0])); rw.history()")
