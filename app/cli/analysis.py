@@ -198,8 +198,7 @@ def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: s
     with contextlib.ExitStack() as stack:
         try:
             if address == "local":
-                cluster, security = _local_cluster(stack, LocalCluster, jobs, dask)
-                client = stack.enter_context(Client(cluster, security=security, timeout=DASK_TIMEOUT))
+                client = _local_client(stack, LocalCluster, Client, jobs, dask)
             else:
                 _check_scheduler(address)
                 client = stack.enter_context(Client(address, timeout=DASK_TIMEOUT))
@@ -214,10 +213,10 @@ def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: s
             yield k, _outcome(future, paths[k])
 
 
-def _local_cluster(stack: contextlib.ExitStack, local_cluster: type, jobs: int, dask: object) -> tuple[object, object]:
-    """A cluster on this machine that only this process can use: TLS with a certificate made
-    for this run (no other user can submit tasks to it), on 127.0.0.1, with no HTTP routes
-    and the scheduler's HTTP server stopped."""
+def _local_client(stack: contextlib.ExitStack, local_cluster: type, client: type, jobs: int, dask: object) -> object:
+    """A client of a cluster on this machine that only this process can use: TLS with a
+    certificate made for this run (no other user can submit tasks to it), on 127.0.0.1,
+    with the HTTP servers of the scheduler and the workers stopped."""
     try:
         from distributed.security import Security
 
@@ -231,7 +230,14 @@ def _local_cluster(stack: contextlib.ExitStack, local_cluster: type, jobs: int, 
         n_workers=jobs, threads_per_worker=1, processes=True, protocol="tls", security=security, host="127.0.0.1",
         dashboard_address=None, worker_dashboard_address=None))
     cluster.scheduler.http_server.stop()
-    return cluster, security
+    connected = stack.enter_context(client(cluster, security=security, timeout=DASK_TIMEOUT))
+    connected.run(_stop_http_server)
+    return connected
+
+
+def _stop_http_server(dask_worker: object) -> None:
+    """Run on each worker of the local cluster: no HTTP endpoint (metrics, health) on it."""
+    dask_worker.http_server.stop()
 
 
 def _check_scheduler(address: str) -> None:

@@ -336,25 +336,38 @@ def test_killing_analyze_leaves_no_worker_and_the_next_run_cleans_up(tmp_path):
     assert sorted(p.name for p in out.iterdir()) == ["fig7.png", "residues.csv", "skipped.csv", "summary.csv"]
 
 
+def _listening_ports() -> set[int]:
+    ports = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        for line in Path(table).read_text().splitlines()[1:]:
+            fields = line.split()
+            if fields[3] == "0A":  # LISTEN
+                ports.add(int(fields[1].rsplit(":", 1)[1], 16))
+    return ports
+
+
 def test_the_local_cluster_is_private(tmp_path, capsys):
-    """``--scheduler`` alone: TLS with a certificate of this run, on 127.0.0.1, no HTTP server on
-    8787; a client without the credentials cannot use it (#16)."""
+    """``--scheduler`` alone: TLS with a certificate of this run, on 127.0.0.1, no HTTP server
+    (no dashboard on 8787, no worker metrics); a client without the credentials cannot use it (#16)."""
     import contextlib
 
     import dask
     from dask.distributed import Client, LocalCluster
 
-    from app.cli.analysis import _local_cluster
+    from app.cli.analysis import _local_client
 
+    before = _listening_ports()
     with contextlib.ExitStack() as stack:
-        cluster, security = _local_cluster(stack, LocalCluster, 1, dask)
+        client = _local_client(stack, LocalCluster, Client, 2, dask)
+        cluster = client.cluster
         assert cluster.scheduler_address.startswith("tls://127.0.0.1:")
-        with socket.socket() as probe:
-            assert probe.connect_ex(("127.0.0.1", 8787)) != 0  # no dashboard or other HTTP endpoint
+        workers = cluster.scheduler.workers.values()
+        comms = {int(address.rsplit(":", 1)[1]) for address in
+                 [cluster.scheduler_address, *(w.address for w in workers), *(w.nanny for w in workers)]}
+        assert _listening_ports() - before == comms  # only the TLS comms: no HTTP endpoint at all
         with pytest.raises((OSError, TypeError, TimeoutError)):
             Client(cluster.scheduler_address, timeout=3)  # no credentials, no tasks
-        with Client(cluster, security=security, timeout=10) as client:
-            assert client.submit(sum, [1, 2]).result() == 3
+        assert client.submit(sum, [1, 2]).result() == 3
     status, out, _ = run(capsys, "analyze", DATA / "1UBQ.pdb.gz", "-o", tmp_path / "out", "--scheduler")
     assert status == 0 and "analysed 1 file(s)" in out
 
