@@ -18,7 +18,7 @@ import numpy as np
 from PySide6.QtCore import QCoreApplication
 
 from app.editor.document import Document
-from app.editor.journal import Journal
+from app.editor.persistence.journal import Journal
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
 

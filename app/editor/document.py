@@ -18,8 +18,8 @@ import numpy as np
 from PySide6.QtCore import QObject, QSignalBlocker, Signal
 from PySide6.QtGui import QUndoStack
 
-from app.editor import records
 from app.editor.commands import EditCommand
+from app.editor.persistence import records
 from app.editor.scene.curves import LevelCurve, SegmentPath
 from app.editor.scene.molecule import ca_rows
 from core.geometry.regularize import FLANK, regularize_region, regularized

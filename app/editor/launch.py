@@ -135,9 +135,9 @@ def run_open(args: argparse.Namespace) -> int:
 def _load(window: MainWindow, args: argparse.Namespace) -> None:
     """Open what the arguments name in ``window``: the most recent journal left by a crash,
     a session or a structure, then the level, hidden layers and compared structures."""
-    from app.editor import journal, records
+    from app.editor.persistence import journal, records
+    from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX, SessionError
     from app.editor.scene.scene import Layer
-    from app.editor.session import SUFFIX as SESSION_SUFFIX, SessionError
 
     if args.recover:
         left = journal.orphans(window.journal.folder)

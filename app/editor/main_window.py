@@ -43,7 +43,6 @@ from PySide6.QtWidgets import (
 from pyvistaqt import QtInteractor
 
 from app import EXAMPLES_DIR
-from app.editor import journal, records, session
 from app.editor.docks.comparison import ComparisonPanel
 from app.editor.docks.console import PythonConsole
 from app.editor.docks.panels import DisplayPanel, RibbonDimensionPanel
@@ -52,6 +51,7 @@ from app.editor.docks.validation import ValidationPanel
 from app.editor.document import Document
 from app.editor.drag import DragController, Mode, PointerEvent
 from app.editor.live_validation import LiveValidation
+from app.editor.persistence import journal, records, session
 from app.editor.picking import PRIORITY, PointerAdapter
 from app.editor.scene.molecule import Colouring
 from app.editor.scene.overlay import Comparison, ComparisonView

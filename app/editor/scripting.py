@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from app.editor.session import SUFFIX as SESSION_SUFFIX
+from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
 
 if TYPE_CHECKING:
     from app.editor.document import Document

@@ -14,8 +14,8 @@ from PySide6.QtWidgets import QMessageBox
 from pytestqt.qtbot import QtBot
 from test_window import _drag_control_point, _window
 
-from app.editor import journal, records
 from app.editor.main_window import MainWindow
+from app.editor.persistence import journal, records
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 ROOT = Path(__file__).resolve().parents[3]

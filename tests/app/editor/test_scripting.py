@@ -10,7 +10,7 @@ from PySide6.QtWidgets import QTabBar
 from pytestqt.qtbot import QtBot
 from test_window import _drag_control_point, _window
 
-from app.editor import journal
+from app.editor.persistence import journal
 from app.main import main
 
 DATA = Path(__file__).resolve().parents[2] / "data"

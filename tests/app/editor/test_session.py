@@ -9,8 +9,8 @@ from PySide6.QtWidgets import QFileDialog
 from pytestqt.qtbot import QtBot
 from test_window import _window
 
-from app.editor import records
 from app.editor.main_window import MainWindow
+from app.editor.persistence import records
 from app.editor.scene.molecule import Colouring
 from app.editor.scene.scene import Layer
 from app.main import main

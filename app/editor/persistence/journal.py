@@ -4,7 +4,7 @@ A journal lives in :func:`state_folder` from the first undo step of a structure 
 document is closed cleanly (saved, or its edits discarded). It starts with the file as
 read and then gets one record per step: each new undo step as the deltas of its
 :class:`~core.protein.model.Edit`, each undo or redo as the new stack position, and the
-level and segment shortly after they change (:mod:`app.editor.records`). Every record goes
+level and segment shortly after they change (:mod:`app.editor.persistence.records`). Every record goes
 to the operating system at once, so a kill loses at most the step being written, and to
 the disk within :data:`SYNC_DELAY_MS` (in a background thread). A running editor holds a
 lock on its journal; a journal nobody holds was left by a crash (:func:`orphans`).
@@ -22,8 +22,8 @@ from pathlib import Path
 import shiboken6
 from PySide6.QtCore import QObject, QTimer
 
-from app.editor import records
 from app.editor.document import Document
+from app.editor.persistence import records
 
 SUFFIX = ".rwjournal"
 SYNC_DELAY_MS = 500

@@ -4,7 +4,7 @@ A session holds the structure as read (embedded: it opens when the original file
 moved), the whole undo history at its position, the level, segment and ribbon kind
 (:meth:`~app.editor.document.Document.recording`), and a ``view`` record: the display
 layers and colouring, the camera and the compared structures (embedded too). It is the
-record format of journals (:mod:`app.editor.records`), written atomically.
+record format of journals (:mod:`app.editor.persistence.records`), written atomically.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from app.editor import records
+from app.editor.persistence import records
 from core.protein.writing import atomic_write
 
 SUFFIX = ".rwsession"
