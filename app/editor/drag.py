@@ -21,6 +21,9 @@ from core.curves.splines import spline_space
 
 PICK_PIXELS = 7.0
 """How close (in pixels) the pointer must come to a control point or the curve to grab it."""
+CLICK_PIXELS = 3.0
+"""A press and release that moves the pointer less than this (pixels) is a click: it picks
+and edits nothing."""
 HANDLE_RADIUS = 0.8
 """Radius of the control-point spheres, Å: a press anywhere on a sphere grabs it."""
 
@@ -78,6 +81,10 @@ class _Grab:
     """Control point, or None when the curve is tugged."""
     u: float
     label: str
+    pixel: float
+    """World size of a pixel at the grabbed point, Å."""
+    moved: bool = False
+    """Whether the pointer has gone CLICK_PIXELS from the press (a drag, not a click)."""
 
 
 class DragController:
@@ -101,13 +108,16 @@ class DragController:
         if grab is None:
             return False
         displacement = event.on_plane(grab.start, grab.normal) - grab.start
-        if grab.index is not None:
-            self.document.preview_move(grab.index, displacement)
-        else:
-            self.document.preview_tug(grab.u, displacement)
+        grab.moved = grab.moved or float(np.linalg.norm(displacement)) >= CLICK_PIXELS * grab.pixel
+        if grab.moved:
+            if grab.index is not None:
+                self.document.preview_move(grab.index, displacement)
+            else:
+                self.document.preview_tug(grab.u, displacement)
         if event.kind == "release":
             self._grab = None
-            self.document.finish_drag(f"{grab.label} at level {self.document.shown_level():.2f}")
+            if grab.moved:
+                self.document.finish_drag(f"{grab.label} at level {self.document.shown_level():.2f}")
         return True
 
     def cancel(self) -> None:
@@ -126,7 +136,9 @@ class DragController:
                 return None
             self.document.pick_point(index)
             centre = curve.control_points[index]
-            return _Grab(event.on_plane(centre, event.view), event.view, index, 0.0, f"Move point {index}")
+            _, _, pixel = event.distances(centre[None])
+            return _Grab(event.on_plane(centre, event.view), event.view, index, 0.0, f"Move point {index}",
+                         float(pixel[0]))
         path = self.document.paths[self.document.segment]
         sample = _nearest_hit(event, curve.samples, np.ones(len(curve.samples), dtype=bool), 0.0)
         if sample is None:
@@ -138,7 +150,8 @@ class DragController:
         point = spline_space(curve.level).evaluate(curve.control_points, u)
         residue = int(np.argmin(np.abs(path.residue_u - u)))
         label = self.document.labels()[residue]
-        return _Grab(event.on_plane(point, event.view), event.view, None, u, f"Tug curve at {label}")
+        _, _, pixel = event.distances(point[None])
+        return _Grab(event.on_plane(point, event.view), event.view, None, u, f"Tug curve at {label}", float(pixel[0]))
 
 
 def _nearest_hit(event: PointerEvent, points: np.ndarray, allowed: np.ndarray, radius: float) -> int | None:

@@ -28,6 +28,7 @@ WINDOWLESS_PLATFORMS = ("offscreen", "minimal", "minimalegl", "linuxfb", "vnc")
 
 
 def open_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the arguments of the editor window (``ribbonwave [FILE] ...``)."""
     parser.add_argument(
         "file",
         nargs="?",
@@ -90,6 +91,8 @@ def open_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_open(args: argparse.Namespace) -> int:
+    """Open the editor on what the arguments name; with ``--script`` or ``--screenshot``, do
+    that and exit (the exit status), else run until the window closes."""
     # Qt and VTK load only for the window, so commands without one start fast.
     from PySide6.QtWidgets import QApplication
 
@@ -158,6 +161,8 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
             window.document.open(args.file, args.ribbon)
         except StructureError as error:
             raise InputError(str(error)) from error
+        if args.file != DEFAULT_STRUCTURE:
+            window.add_recent(args.file)
     if args.level is not None:
         window.document.set_level(args.level)
     for name in args.hide:

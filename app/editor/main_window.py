@@ -150,7 +150,7 @@ class MainWindow(QMainWindow):
                 raise
             QMessageBox.critical(self, APP_NAME, str(error))
             return False
-        self._add_recent(Path(path))
+        self.add_recent(Path(path))
         return True
 
     def open_session(self, path: Path, *, raise_errors: bool = False) -> bool:
@@ -168,7 +168,7 @@ class MainWindow(QMainWindow):
             QMessageBox.critical(self, APP_NAME, str(error))
             return False
         self._apply_view(view)
-        self._add_recent(Path(path))
+        self.add_recent(Path(path))
         return True
 
     def write_session(self, path: Path) -> Path:
@@ -388,7 +388,9 @@ class MainWindow(QMainWindow):
         self.undo_action.setIcon(icon(pixmap.SP_ArrowBack))
         self.undo_action.setIconText("Undo")  # the toolbar keeps a short label; the menu names the edit
         self.redo_action = stack.createRedoAction(self, "&Redo")
-        self.redo_action.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence.StandardKey.Redo])
+        # each key once: QKeySequence.StandardKey.Redo is Ctrl+Shift+Z on Linux, and a key bound
+        # twice is an "ambiguous shortcut" that does nothing
+        self.redo_action.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
         self.redo_action.setIcon(icon(pixmap.SP_ArrowForward))
         self.redo_action.setIconText("Redo")
         self.cancel_action = self._action("Cancel Drag / Deselect", QKeySequence(Qt.Key.Key_Escape), self._cancel)
@@ -567,19 +569,26 @@ class MainWindow(QMainWindow):
         except (StructureError, OSError) as error:
             QMessageBox.critical(self, APP_NAME, str(error))
             return False
-        self._add_recent(path)
+        self.add_recent(path)
         return True
 
-    def _add_recent(self, path: Path) -> None:
+    def add_recent(self, path: Path) -> None:
+        """Put ``path`` first in File ▸ Open Recent."""
         name = str(path.resolve())
         files = [name] + [f for f in self.recent_files() if f != name]
         self.settings.setValue(RECENT_KEY, files[:MAX_RECENT])
+
+    def _open_recent(self, path: Path) -> None:
+        if path.name.endswith(session.SUFFIX):
+            self.open_session(path)
+        else:
+            self.open_file(path)
 
     def _fill_recent_menu(self) -> None:
         self.recent_menu.clear()
         for name in self.recent_files():
             action = self.recent_menu.addAction(name)
-            action.triggered.connect(lambda _=False, name=name: self.open_file(Path(name)))
+            action.triggered.connect(lambda _=False, name=name: self._open_recent(Path(name)))
         self.recent_menu.addSeparator()
         clear = self.recent_menu.addAction("Clear Menu")
         clear.triggered.connect(lambda: self.settings.setValue(RECENT_KEY, []))

@@ -55,6 +55,7 @@ class RibbonDimensionPanel(QWidget):
         self.spin = QDoubleSpinBox()
         self.spin.setDecimals(2)
         self.spin.setSingleStep(0.05)
+        self.spin.setKeyboardTracking(False)  # a typed level (2.5) counts on Enter or focus-out, not per digit
         self.integers = QCheckBox("Integer levels only")
         self.level_text = QLabel()
         self.segments_text = QLabel()

@@ -545,3 +545,49 @@ def test_a_display_qt_cannot_use_is_a_one_line_error(qapp: QApplication, monkeyp
     assert main([str(DATA / "1UBQ.pdb.gz")]) == 1
     err = capsys.readouterr().err
     assert err.startswith(f"ribbonwave: error: {message}") and err.count("\n") == 1
+
+
+def test_a_click_on_a_control_point_picks_and_edits_nothing(window: MainWindow) -> None:
+    """A press and release without motion, or with a 2-pixel jitter, is a click (#17)."""
+    document = window.document
+    original = document.model.coords.copy()
+    for jitter in ((0, 0), (2, 0), (1, 1)):
+        index = _drag_control_point(window, 3, jitter, steps=1)
+        assert document.pick is not None and document.pick.index == index
+        assert document.undo_stack.count() == 0 and not document.modified
+        assert np.array_equal(document.model.coords, original)
+    _drag_control_point(window, 3, (12, 0), steps=3)  # a real drag is one undo step
+    assert document.undo_stack.count() == 1
+
+
+def test_redo_on_ctrl_shift_z_and_ctrl_y(window: MainWindow, qtbot: QtBot) -> None:
+    document = window.document
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow)  # shortcuts go to the active window
+    _drag_control_point(window, 3, (30, 20), steps=2)
+    moved = document.model.coords.copy()
+    for keys in ((Qt.Key.Key_Z, Qt.KeyboardModifier.ShiftModifier | Qt.KeyboardModifier.ControlModifier),
+                 (Qt.Key.Key_Y, Qt.KeyboardModifier.ControlModifier)):
+        qtbot.keyClick(window, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+        assert document.undo_stack.index() == 0
+        qtbot.keyClick(window, *keys)
+        assert document.undo_stack.index() == 1 and np.array_equal(document.model.coords, moved)
+
+
+def test_the_level_box_takes_a_typed_fraction(window: MainWindow, qtbot: QtBot) -> None:
+    spin = window.dimension_panel.spin
+    spin.selectAll()
+    qtbot.keyClicks(spin, "2.5")
+    assert window.document.level != 2.5  # nothing happens per digit
+    qtbot.keyClick(spin, Qt.Key.Key_Return)
+    assert window.document.level == 2.5 and spin.value() == 2.5
+
+
+def test_a_file_opened_from_the_command_line_is_a_recent_file(qapp: QApplication, tmp_path: Path,
+                                                               private_settings: Path) -> None:
+    assert main([str(DATA / "1UBQ.pdb.gz"), "--screenshot", str(tmp_path / "shot.png")]) == 0
+    window = MainWindow()
+    try:
+        assert window.recent_files()[0] == str((DATA / "1UBQ.pdb.gz").resolve())
+    finally:
+        window.close()
