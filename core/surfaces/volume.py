@@ -89,8 +89,10 @@ class DensityMap:
 def read_map(path: str | os.PathLike[str]) -> DensityMap:
     """Read a CCP4/MRC map (optionally gzipped); the whole unit cell, gaps filled with the mean."""
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise MapError(f"{path}: no such file")
+    if not path.is_file():
+        raise MapError(f"{path}: not a regular file (a folder, device or FIFO is not read)")
     try:
         ccp4 = gemmi.read_ccp4_map(str(path))
         ccp4.setup(float("nan"), gemmi.MapSetup.Full)
