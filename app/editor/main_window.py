@@ -403,7 +403,7 @@ class MainWindow(QMainWindow):
         self.mode_actions = QActionGroup(self)
         for mode, key in ((Mode.POINT, "M"), (Mode.CURVE, "T")):
             action = self._action(mode.value[0].upper() + mode.value[1:], QKeySequence(key),
-                                  lambda _=False, mode=mode: setattr(self.controller, "mode", mode))
+                                  lambda _=False, mode=mode: self._set_mode(mode))
             action.setCheckable(True)
             action.setChecked(mode is self.controller.mode)
             self.mode_actions.addAction(action)
@@ -501,6 +501,10 @@ class MainWindow(QMainWindow):
         if used and event.kind == "press":
             self.plotter.renderer.SetUseFXAA(False)
         return used
+
+    def _set_mode(self, mode: Mode) -> None:
+        self.controller.mode = mode
+        self._update_status()
 
     def _cancel(self) -> None:
         if self.controller.dragging:
@@ -610,8 +614,10 @@ class MainWindow(QMainWindow):
         labels["segment"].setText(f"chain {document.segment_label(document.segment)}")
         labels["level"].setText(f"level {document.shown_level():.2f} / {document.max_level:.2f}")
         pick = document.pick
+        idle = ("Click a control point to pick it; drag it to edit." if self.controller.mode is Mode.POINT
+                else "Drag the curve to tug it.")
         labels["pick"].setText(
-            "Click a control point to pick it; drag it to edit. Drag elsewhere to turn the view." if pick is None
+            f"{idle} Drag elsewhere to turn the view." if pick is None
             else f"point {pick.index} moves {len(pick.residues)} residues: {document.residue_range(pick.residues)}"
         )
 

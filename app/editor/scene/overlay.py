@@ -39,11 +39,12 @@ from core.protein.structure import BackboneSegment, Structure
 CORE_CUTOFF = 3.0
 """Å: the fit is refined on the paired Cα closer than this after fitting on themselves."""
 PALETTE: tuple[tuple[int, int, int], ...] = (
-    (31, 119, 180), (44, 160, 44), (148, 103, 189), (23, 190, 207), (140, 86, 75),
-    (227, 119, 194), (255, 127, 14), (188, 189, 34), (90, 90, 90),
+    (31, 119, 180), (44, 160, 44), (0, 128, 128), (227, 119, 194), (200, 80, 0),
+    (170, 0, 120), (60, 60, 160), (188, 189, 34), (150, 70, 40),
 )  # fmt: skip
-"""Colours of the compared structures, in the order they are added (away from the
-secondary-structure red, yellow and grey of the edited structure's tube)."""
+"""Colours of the compared structures, in the order they are added: each at least 60 (RGB
+distance) from every colour of the editor (the tube's secondary structure, the curves,
+control points, the picked point and the background)."""
 TUBE_RADIUS = 0.35
 """Å, the thin tubes of the compared structures."""
 TUBE_SIDES = 8

@@ -167,3 +167,13 @@ def test_command_line_compare_screenshot(qtbot: QtBot, tmp_path: Path, capsys: p
     assert "has no protein chain 'Q'; chains: E, I" in capsys.readouterr().err
     assert main([str(DATA / "3PTB.pdb.gz"), "--hide", "nothing", "--screenshot", str(other)]) == 1
     assert "--hide: no layer 'nothing'" in capsys.readouterr().err
+
+
+def test_compared_colours_are_distinct_from_every_editor_colour() -> None:
+    """The third compared structure was the purple of the control points (#17)."""
+    from app.editor.scene import molecule, overlay, scene
+
+    editor = [*molecule.SS_COLOURS.values(), scene.CURVE_COLOUR, scene.OTHER_CURVE_COLOUR, scene.POINT_COLOUR,
+              scene.PICKED_COLOUR, scene.POLYGON_COLOUR, scene.CA_STICK_COLOUR, (255, 255, 255), (223, 229, 236)]
+    distances = np.linalg.norm(np.array(overlay.PALETTE)[:, None] - np.array(editor)[None], axis=2)
+    assert distances.min() >= 60

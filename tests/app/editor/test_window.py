@@ -591,3 +591,12 @@ def test_a_file_opened_from_the_command_line_is_a_recent_file(qapp: QApplication
         assert window.recent_files()[0] == str((DATA / "1UBQ.pdb.gz").resolve())
     finally:
         window.close()
+
+
+def test_the_status_bar_follows_the_drag_mode(window: MainWindow, qtbot: QtBot) -> None:
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow)
+    qtbot.keyClick(window, Qt.Key.Key_T)
+    assert window.status_labels["pick"].text().startswith("Drag the curve to tug it.")
+    qtbot.keyClick(window, Qt.Key.Key_M)
+    assert window.status_labels["pick"].text().startswith("Click a control point to pick it")
