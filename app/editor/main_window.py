@@ -16,7 +16,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QBuffer, QByteArray, QIODevice, QPoint, QSettings, Qt
+from PySide6.QtCore import QBuffer, QByteArray, QIODevice, QPoint, QSettings, QSize, Qt
 from PySide6.QtGui import (
     QAction,
     QActionGroup,
@@ -63,6 +63,10 @@ from core.protein.writing import atomic_write
 
 APP_NAME = "ribbonwave"
 RECENT_KEY = "recentFiles"
+GEOMETRY_KEY = "windowGeometry"
+LAYOUT_KEY = "windowLayout"
+DEFAULT_SIZE = QSize(1400, 900)
+"""The window's first size, where the screen has room for it."""
 MAX_RECENT = 8
 STRUCTURE_FILTER = "Structures (*.pdb *.ent *.cif *.mmcif *.gz);;All files (*)"
 SAVE_FILTERS = {"PDB (*.pdb *.pdb.gz *.ent)": ".pdb", "mmCIF (*.cif *.cif.gz *.mmcif)": ".cif"}
@@ -78,7 +82,7 @@ class MainWindow(QMainWindow):
         self.document = document if document is not None else Document()
         self.document.setParent(self)
         self.settings = QSettings(APP_NAME, APP_NAME)
-        self.resize(1400, 900)
+        self.resize(_fitted(DEFAULT_SIZE))
         self.setAcceptDrops(True)
         self.unattended = False
         """Run by a script: no dialog waits for a person, and unsaved edits stay in the journal."""
@@ -135,6 +139,7 @@ class MainWindow(QMainWindow):
         self.document.picked.connect(self._update_regularize_action)
         self._update_title()
         self._update_status()
+        self._restore_layout()
 
     # ------------------------------------------------------------------ files
 
@@ -343,6 +348,8 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self.journal.stop()  # deleted by maybe_save unless it holds unsaved edits
+        self.settings.setValue(GEOMETRY_KEY, self.saveGeometry())
+        self.settings.setValue(LAYOUT_KEY, self.saveState())
         self.surface_layer.shutdown()
         self.pointer.close()
         self.plotter.close()
@@ -460,6 +467,16 @@ class MainWindow(QMainWindow):
         self.status_labels = {key: QLabel() for key in ("file", "segment", "level", "pick")}
         for key, label in self.status_labels.items():
             self.statusBar().addWidget(label, 1 if key == "pick" else 0)
+
+    def _restore_layout(self) -> None:
+        """The size, place and dock layout the window had when it last closed (kept on screen)."""
+        geometry, layout = self.settings.value(GEOMETRY_KEY), self.settings.value(LAYOUT_KEY)
+        if geometry is not None:
+            self.restoreGeometry(geometry)
+            self.resize(_fitted(self.size()))
+        if layout is not None:
+            self.restoreState(layout)
+            self._hide_stale_tab_bars()
 
     def _hide_stale_tab_bars(self) -> None:
         """Qt (6.11) leaves the tab bar of a two-dock group visible, under the docks, once a third
@@ -645,6 +662,15 @@ def write_png(image: QImage, path: Path, *, overwrite: bool = False) -> None:
     if not image.save(buffer, "PNG"):
         raise OSError(f"{path}: cannot encode the image")
     atomic_write(path, bytes(data))
+
+
+def _fitted(size: QSize) -> QSize:
+    """``size`` shrunk to the available area of the screen (a 1366 x 768 laptop shows it all)."""
+    screen = QApplication.primaryScreen()
+    if screen is None:
+        return size
+    room = screen.availableGeometry()
+    return QSize(min(size.width(), room.width()), min(size.height(), room.height()))
 
 
 def time_label(path: Path) -> str:

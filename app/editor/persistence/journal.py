@@ -52,6 +52,7 @@ class Journal(QObject):
         self._fd: int | None = None
         self._mirror: list[object] = []  # the undo commands journalled, by stack position
         self._last: dict | None = None  # the state of the last index record
+        self._stopped = False
         self._sync = ThreadPoolExecutor(max_workers=1, thread_name_prefix="journal-sync")
         self._sync_timer = QTimer(self, singleShot=True, interval=SYNC_DELAY_MS)
         self._sync_timer.timeout.connect(self._schedule_sync)
@@ -80,9 +81,11 @@ class Journal(QObject):
     def stop(self) -> None:
         """Stop journalling (the window closes): the file is kept as it is, if any."""
         self.keep()
-        stack = self.document.undo_stack
-        stack.indexChanged.disconnect(self._step)
-        stack.cleanChanged.disconnect(self._step)
+        if not self._stopped:
+            self._stopped = True
+            stack = self.document.undo_stack
+            stack.indexChanged.disconnect(self._step)
+            stack.cleanChanged.disconnect(self._step)
 
     def write_all(self) -> None:
         """Journal the whole document at once (after a restore: the history is not new)."""

@@ -136,6 +136,13 @@ class Scene(QObject):
         renderer.reset_camera(render=False)
         renderer.camera.zoom(1.15)
 
+    def frame_segment(self) -> None:
+        """Centre the view on the edited segment and fit it in, looking from where the camera is."""
+        structure = self.document.structure
+        ca = self.document.model.coords[self.document.ca_rows[structure.segments[self.document.segment].residue_index]]
+        low, high = ca.min(axis=0) - 2.0, ca.max(axis=0) + 2.0
+        self.plotter.renderer.ResetCamera(low[0], high[0], low[1], high[1], low[2], high[2])
+
     def shown_control_points(self) -> np.ndarray:
         """Indices (into the level curve's control points) of the spheres on screen."""
         return self._shown_points
@@ -246,6 +253,7 @@ class Scene(QObject):
 
     def _on_segment(self) -> None:
         self._colour_curves()
+        self.frame_segment()
         self._on_level()
 
     def _colour_curves(self) -> None:

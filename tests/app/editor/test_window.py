@@ -600,3 +600,40 @@ def test_the_status_bar_follows_the_drag_mode(window: MainWindow, qtbot: QtBot) 
     assert window.status_labels["pick"].text().startswith("Drag the curve to tug it.")
     qtbot.keyClick(window, Qt.Key.Key_M)
     assert window.status_labels["pick"].text().startswith("Click a control point to pick it")
+
+
+def test_choosing_another_chain_frames_it(qtbot: QtBot) -> None:
+    """4HHB: the segment box moves the camera to the chosen chain and fits it in the view (#17)."""
+    window = _window(qtbot, DATA / "4HHB.pdb.gz")
+    document = window.document
+    window.dimension_panel.segment.setCurrentIndex(4)  # as a choice in the box does
+    segment = document.structure.segments[4]
+    ca = document.model.coords[document.ca_rows[segment.residue_index]]
+    camera = window.plotter.renderer.camera
+    assert np.allclose(camera.focal_point, (ca.min(axis=0) + ca.max(axis=0)) / 2, atol=0.5)
+    width, height = window.plotter.width(), window.plotter.height()
+    pixels = np.array([_display(window, point) for point in ca])
+    assert (pixels >= 0).all() and (pixels[:, 0] <= width).all() and (pixels[:, 1] <= height).all()
+    assert np.ptp(pixels[:, 0]) > width / 4 or np.ptp(pixels[:, 1]) > height / 4  # framed, not a speck
+
+
+def test_the_window_fits_a_small_screen_and_keeps_its_layout(qtbot: QtBot, monkeypatch: pytest.MonkeyPatch) -> None:
+    """On a 1366 x 768 laptop the window fits; its size and docks come back at the next start (#17)."""
+    from PySide6.QtCore import QRect
+
+    class Laptop:
+        def availableGeometry(self) -> QRect:  # noqa: N802 (Qt's name)
+            return QRect(0, 0, 1366, 728)
+
+    monkeypatch.setattr(QApplication, "primaryScreen", staticmethod(lambda: Laptop()))
+    window = MainWindow()
+    qtbot.addWidget(window)
+    assert window.width() <= 1366 and window.height() <= 728
+    window.resize(1000, 700)
+    window.console_dock.show()
+    qtbot.wait(10)
+    size = window.size()  # (as near 1000 x 700 as the docks allow)
+    window.close()
+    again = MainWindow()
+    qtbot.addWidget(again)
+    assert again.size() == size and again.console_dock.isVisibleTo(again)
