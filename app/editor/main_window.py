@@ -188,10 +188,7 @@ class MainWindow(QMainWindow):
         """Ask for a file name and save the session there."""
         if self.document.model is None:
             return False
-        source = self.document.path
-        folder = Path.home() if source is None or source.parent == EXAMPLES_DIR else source.parent
-        stem = source.name.split(".")[0] if source is not None else "session"
-        name, _ = QFileDialog.getSaveFileName(self, "Save Session", str(folder / f"{stem}{session.SUFFIX}"),
+        name, _ = QFileDialog.getSaveFileName(self, "Save Session", str(self._suggested(session.SUFFIX)),
                                               SESSION_FILTER)
         if not name:
             return False
@@ -263,11 +260,8 @@ class MainWindow(QMainWindow):
         """Ask for a file name (PDB or mmCIF by its extension) and save there."""
         if self.document.model is None:
             return False
-        source = self.document.path
-        folder = Path.home() if source is None or source.parent == EXAMPLES_DIR else source.parent
-        stem = source.name.split(".")[0] if source is not None else "structure"
         suffix = ".cif" if self.document.structure.source_format == "mmcif" else ".pdb"
-        name, chosen = QFileDialog.getSaveFileName(self, "Save As", str(folder / f"{stem}_edited{suffix}"),
+        name, chosen = QFileDialog.getSaveFileName(self, "Save As", str(self._suggested(f"_edited{suffix}")),
                                                    ";;".join(SAVE_FILTERS))
         if not name:
             return False
@@ -289,7 +283,7 @@ class MainWindow(QMainWindow):
                 return False
             path = Path(name) if name.lower().endswith(".png") else Path(name + ".png")
         try:
-            write_png(self._view_image(), path, overwrite=True)  # the dialog asked about an existing file
+            self.export_view(path, overwrite=True)  # the dialog asked about an existing file
         except OSError as error:
             QMessageBox.critical(self, APP_NAME, f"cannot write {path}: {error.strerror or error}")
             return False
@@ -547,6 +541,13 @@ class MainWindow(QMainWindow):
         if name:
             self.open_file(Path(name))
 
+    def _suggested(self, ending: str) -> Path:
+        """A file name to offer for saving: the structure's name with ``ending``, beside it
+        (in the home folder for the bundled examples)."""
+        source = self.document.path
+        folder = Path.home() if source is None or source.parent == EXAMPLES_DIR else source.parent
+        return folder / f"{source.name.split('.')[0] if source is not None else 'structure'}{ending}"
+
     def _open_session_dialog(self) -> None:
         folder = str(self.document.path.parent) if self.document.path else str(Path.home())
         name, _ = QFileDialog.getOpenFileName(self, "Open Session", folder, SESSION_FILTER)
@@ -562,7 +563,7 @@ class MainWindow(QMainWindow):
         self.journal.write_all()
 
     def _view(self) -> session.View:
-        compared = [session.Compared(item.path, item.source, item.chain, item.visible)
+        compared = [session.ComparedFile(item.path, item.source, item.chain, item.visible)
                     for item in self.comparison.items]
         camera = [list(map(float, vector)) for vector in self.plotter.camera_position]
         return session.View(sorted(layer.name for layer in self.scene.layers), self.scene.colouring.value,

@@ -124,11 +124,11 @@ def _check_pdb_columns(structure: Structure, coords: np.ndarray, path: Path) -> 
         ("B-factor", structure.atoms.b_factor, PDB_VALUE_RANGE, "-99.99 to 999.99"),
         ("occupancy", structure.atoms.occupancy, PDB_VALUE_RANGE, "-99.99 to 999.99"),
     ):
-        bad = np.flatnonzero(np.any((values < low) | (values > high), axis=-1) if values.ndim > 1
-                             else (values < low) | (values > high))
+        rows = values.reshape(len(values), -1)  # (n, 3) coordinates or (n, 1) values
+        outside = (rows < low) | (rows > high)
+        bad = np.flatnonzero(outside.any(axis=1))
         if len(bad):
-            value = np.asarray(values[bad[0]]).ravel()
-            shown = value[np.argmax((value < low) | (value > high))]
+            shown = rows[bad[0]][outside[bad[0]]][0]
             raise StructureError(f"{path}: {len(bad)} atom(s) have a {name} that PDB columns cannot hold "
                                  f"(e.g. atom {bad[0] + 1}: {shown:g}; PDB holds {holds}); "
                                  "write mmCIF (.cif) instead")

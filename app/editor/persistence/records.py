@@ -62,18 +62,17 @@ def decode(data: bytes) -> tuple[list[Record], bool]:
     the last record returned). Raises RecordError for a file that is not one of ours."""
     if not data.startswith(MAGIC):
         raise RecordError("not a ribbonwave journal or session file")
-    records, offset = [], len(MAGIC)
-    while offset < len(data):
+    records, offset, damaged = [], len(MAGIC), False
+    while offset < len(data) and not damaged:
         record, offset = _record_at(data, offset)
-        if record is None:
-            return records, True
-        records.append(record)
+        damaged = record is None
+        records += [] if damaged else [record]
     if records and records[0].kind == "header" and records[0].fields.get("version", 0) > VERSION:
         raise RecordError(f"written by a newer ribbonwave (format {records[0].fields['version']}; "
                           f"this one reads format {VERSION})")
-    if not records or records[0].kind != "header":
+    if (records[0].kind != "header") if records else not damaged:  # (cut inside the header: nothing to read)
         raise RecordError("no header record: not a ribbonwave journal or session file")
-    return records, False
+    return records, damaged
 
 
 def _record_at(data: bytes, offset: int) -> tuple[Record | None, int]:

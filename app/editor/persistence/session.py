@@ -25,7 +25,7 @@ class SessionError(ValueError):
 
 
 @dataclass(frozen=True)
-class Compared:
+class ComparedFile:
     """A compared structure of a session: its file name and bytes, chain and visibility."""
 
     path: Path
@@ -42,7 +42,7 @@ class View:
     colouring: str
     fat_helices: bool
     camera: list[list[float]]
-    compared: list[Compared]
+    compared: list[ComparedFile]
 
     def record(self) -> records.Record:
         """The ``view`` record of this view."""
@@ -56,7 +56,7 @@ class View:
     def of(cls, record: records.Record) -> View:
         """The view of a ``view`` record."""
         fields = record.fields
-        compared = [Compared(Path(c["path"]), record.arrays[f"compared_{k}"].tobytes(), c["chain"], c["visible"])
+        compared = [ComparedFile(Path(c["path"]), record.arrays[f"compared_{k}"].tobytes(), c["chain"], c["visible"])
                     for k, c in enumerate(fields["compared"])]
         return cls(fields["layers"], fields["colouring"], fields["fat_helices"], fields["camera"], compared)
 
