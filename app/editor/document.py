@@ -65,6 +65,8 @@ class Document(QObject):
     """The picked control point changed (see :attr:`pick`)."""
     fileChanged = Signal()
     """The file name, the save target or the modified state changed."""
+    selectionChanged = Signal()
+    """The selected residues changed (see :attr:`selection`)."""
 
     def __init__(self, parent: QObject | None = None) -> None:
         super().__init__(parent)
@@ -85,6 +87,8 @@ class Document(QObject):
         self.level = 0.0
         self.multiresolution = True
         self.pick: Pick | None = None
+        self.selection = np.empty(0, dtype=np.int64)
+        """Selected residues: rows of the residue table, sorted (any segments)."""
         self.regularize_on_release = True
         """A drag's undo step holds the edit followed by :func:`core.geometry.regularize.regularized`."""
         self.regularize_while_dragging = False
@@ -199,8 +203,31 @@ class Document(QObject):
         if index is None:
             self._set_pick(None)
             return
-        probe = self._model.move_point(self.segment, self.shown_level(), index, np.array([1.0, 0.0, 0.0]))
-        self._set_pick(Pick(index, probe.residues))
+        self._set_pick(Pick(index, self.point_residues(index)))
+
+    def point_residues(self, index: int) -> np.ndarray:
+        """Residues (within the current segment) that moving control point ``index`` of the
+        current level curve would move."""
+        return self._model.move_point(self.segment, self.shown_level(), index, np.array([1.0, 0.0, 0.0])).residues
+
+    def select(self, rows: np.ndarray | list[int]) -> None:
+        """Select residues by residue-table row (none: an empty selection)."""
+        rows = np.unique(np.asarray(rows, dtype=np.int64))
+        if len(rows) and not 0 <= rows[0] <= rows[-1] < self.structure.n_residues:
+            raise ValueError(f"residue rows must be in [0, {self.structure.n_residues - 1}]")
+        if not np.array_equal(rows, self.selection):
+            self.selection = rows
+            self.selectionChanged.emit()
+
+    def row_label(self, row: int) -> str:
+        """The label of residue-table row ``row``, e.g. ``'A:LYS48'``."""
+        segment = self.structure.segments[self.segment_of(row)]
+        return segment.labels[row - int(segment.residue_index[0])]
+
+    def segment_of(self, row: int) -> int:
+        """The segment holding residue-table row ``row``."""
+        starts = [s.residue_index[0] for s in self.structure.segments]
+        return int(np.searchsorted(starts, row, side="right") - 1)
 
     @property
     def dragging(self) -> bool:
@@ -338,6 +365,7 @@ class Document(QObject):
         self.segment = 0
         self.level = float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
         self.pick = None
+        self.selection = np.empty(0, dtype=np.int64)
         self._preview = None
         self._curves.clear()
         self.loaded.emit()

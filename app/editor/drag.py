@@ -25,7 +25,10 @@ CLICK_PIXELS = 3.0
 """A press and release that moves the pointer less than this (pixels) is a click: it picks
 and edits nothing."""
 HANDLE_RADIUS = 0.8
-"""Radius of the control-point spheres, Å: a press anywhere on a sphere grabs it."""
+"""Smallest radius of the control-point spheres, Å: a press anywhere on a sphere grabs it."""
+HANDLE_BOX = 3.0
+"""Edge of the handle box around the picked point, in sphere radii: its faces stand clear of
+the sphere, and a press on one moves the point in that face's plane."""
 
 
 class Mode(StrEnum):
@@ -47,6 +50,8 @@ class PointerEvent:
     view : (3,) unit viewing direction of the camera (direction of projection).
     pixel : world size of one pixel at ``origin``.
     pixel_growth : growth of the pixel size per Å along the ray (0 for parallel projection).
+    shift : whether Shift is held.
+    double : whether a press is the second of a double click.
     """
 
     kind: Literal["press", "move", "release"]
@@ -55,6 +60,8 @@ class PointerEvent:
     view: np.ndarray
     pixel: float
     pixel_growth: float
+    shift: bool = False
+    double: bool = False
 
     def distances(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Depth along the ray, distance from the ray (both Å) and the size of a pixel there
@@ -83,6 +90,8 @@ class _Grab:
     label: str
     pixel: float
     """World size of a pixel at the grabbed point, Å."""
+    axes: np.ndarray
+    """(k, 3) the axes Shift may constrain the motion to: x, y, z, or those of a box face's plane."""
     moved: bool = False
     """Whether the pointer has gone CLICK_PIXELS from the press (a drag, not a click)."""
 
@@ -93,6 +102,8 @@ class DragController:
     def __init__(self, document: Document, mode: Mode = Mode.POINT) -> None:
         self.document = document
         self.mode = mode
+        self.point_radius = HANDLE_RADIUS
+        """Radius of the control-point spheres as drawn, Å (the view sizes them)."""
         self._grab: _Grab | None = None
 
     @property
@@ -108,6 +119,9 @@ class DragController:
         if grab is None:
             return False
         displacement = event.on_plane(grab.start, grab.normal) - grab.start
+        if event.shift:  # along the one allowed axis the pointer moves most along
+            axis = grab.axes[np.argmax(np.abs(grab.axes @ displacement))]
+            displacement = axis * float(axis @ displacement)
         grab.moved = grab.moved or float(np.linalg.norm(displacement)) >= CLICK_PIXELS * grab.pixel
         if grab.moved:
             if grab.index is not None:
@@ -131,14 +145,17 @@ class DragController:
             return None
         curve = self.document.level_curve()
         if self.mode is Mode.POINT:
-            index = _nearest_hit(event, curve.control_points, curve.visible, HANDLE_RADIUS)
+            face = self._press_box(event)
+            if face is not None:
+                return face
+            index = _nearest_hit(event, curve.control_points, curve.visible, self.point_radius)
             if index is None:
                 return None
             self.document.pick_point(index)
             centre = curve.control_points[index]
             _, _, pixel = event.distances(centre[None])
             return _Grab(event.on_plane(centre, event.view), event.view, index, 0.0, f"Move point {index}",
-                         float(pixel[0]))
+                         float(pixel[0]), np.eye(3))
         path = self.document.paths[self.document.segment]
         sample = _nearest_hit(event, curve.samples, np.ones(len(curve.samples), dtype=bool), 0.0)
         if sample is None:
@@ -151,7 +168,39 @@ class DragController:
         residue = int(np.argmin(np.abs(path.residue_u - u)))
         label = self.document.labels()[residue]
         _, _, pixel = event.distances(point[None])
-        return _Grab(event.on_plane(point, event.view), event.view, None, u, f"Tug curve at {label}", float(pixel[0]))
+        return _Grab(event.on_plane(point, event.view), event.view, None, u, f"Tug curve at {label}", float(pixel[0]),
+                     np.eye(3))
+
+    def _press_box(self, event: PointerEvent) -> _Grab | None:
+        """A press on a face of the picked point's handle box, off its sphere: the point moves
+        in that face's plane."""
+        pick = self.document.pick
+        if pick is None:
+            return None
+        centre = self.document.level_curve().control_points[pick.index]
+        entry = _box_entry(event, centre, 0.5 * HANDLE_BOX * self.point_radius)
+        _, off_ray, _ = event.distances(centre[None])
+        if entry is None or off_ray[0] <= self.point_radius:
+            return None
+        point, axis = entry
+        normal = np.eye(3)[axis]
+        _, _, pixel = event.distances(point[None])
+        plane = "xyz".replace("xyz"[axis], "")
+        return _Grab(point, normal, pick.index, 0.0, f"Move point {pick.index} in {plane}", float(pixel[0]),
+                     np.delete(np.eye(3), axis, axis=0))
+
+
+def _box_entry(event: PointerEvent, centre: np.ndarray, half: float) -> tuple[np.ndarray, int] | None:
+    """Where the ray enters the axis-aligned cube of half-edge ``half`` (Å) around ``centre``,
+    and the axis of the face it enters through; None if it misses (slab method)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t1 = (centre - half - event.origin) / event.direction
+        t2 = (centre + half - event.origin) / event.direction
+    near, far = np.where(np.isnan(t1), -np.inf, np.minimum(t1, t2)), np.where(np.isnan(t2), np.inf, np.maximum(t1, t2))
+    enter, leave = near.max(), far.min()
+    if not np.isfinite(enter) or enter > leave or leave < 0:
+        return None
+    return event.origin + enter * event.direction, int(np.argmax(near))
 
 
 def _nearest_hit(event: PointerEvent, points: np.ndarray, allowed: np.ndarray, radius: float) -> int | None:

@@ -21,6 +21,7 @@ from PySide6.QtGui import (
     QAction,
     QActionGroup,
     QCloseEvent,
+    QCursor,
     QDragEnterEvent,
     QDropEvent,
     QImage,
@@ -32,11 +33,13 @@ from PySide6.QtWidgets import (
     QDockWidget,
     QFileDialog,
     QLabel,
+    QLineEdit,
     QMainWindow,
     QMessageBox,
     QScrollArea,
     QStyle,
     QTabBar,
+    QToolTip,
     QUndoView,
     QWidget,
 )
@@ -46,10 +49,12 @@ from app import EXAMPLES_DIR
 from app.editor.docks.comparison import ComparisonPanel
 from app.editor.docks.console import PythonConsole
 from app.editor.docks.panels import DisplayPanel, RibbonDimensionPanel
+from app.editor.docks.sequence import SequenceBar
 from app.editor.docks.surfaces import SurfaceLayer, SurfacePanel
 from app.editor.docks.validation import ValidationPanel
 from app.editor.document import Document
-from app.editor.drag import DragController, Mode, PointerEvent
+from app.editor.drag import CLICK_PIXELS, DragController, Mode, PointerEvent
+from app.editor.identify import Hit, describe, identify
 from app.editor.live_validation import LiveValidation
 from app.editor.persistence import journal, records, session
 from app.editor.picking import PRIORITY, PointerAdapter
@@ -58,6 +63,7 @@ from app.editor.scene.overlay import Comparison, ComparisonView
 from app.editor.scene.scene import Layer, Scene
 from app.editor.scene.validation_markers import ValidationMarkers
 from app.editor.scripting import EditorAPI
+from core.protein.lookup import find_residues
 from core.protein.structure import StructureError
 from core.protein.writing import atomic_write
 
@@ -100,6 +106,8 @@ class MainWindow(QMainWindow):
         self.markers = ValidationMarkers(self.validation, self.scene)
         self.controller = DragController(self.document)
         self.pointer = PointerAdapter(self.plotter, self._on_pointer)
+        self._press_at: tuple[int, int] | None = None  # where a press the camera took began (display pixels)
+        self._hovered: str | None = None
 
         self.dimension_panel = RibbonDimensionPanel(self.document)
         self.display_panel = DisplayPanel(self.scene)
@@ -114,14 +122,17 @@ class MainWindow(QMainWindow):
         self.rw = EditorAPI(self)
         """The ``rw`` object of scripts and of the Python console."""
         self.console = PythonConsole({"rw": self.rw, "np": np})
-        docks = [self._dock("Ribbon dimension", self.dimension_panel),
+        docks = [self._dock("Ribbon dimension", _scrolled(self.dimension_panel)),
                  self._dock("Display", _scrolled(self.display_panel)),
                  self._dock("Undo history", self.history), self._dock("Validation", _scrolled(self.validation_panel)),
                  self._dock("Compared structures", self.comparison_panel)]
         docks.append(self._dock("Surface", self.surface_panel))
+        self.sequence_bar = SequenceBar(self.document)
+        self.sequence_bar.strip.residuesActivated.connect(self.select_and_centre)
+        docks.append(self._dock("Sequence", self.sequence_bar, Qt.DockWidgetArea.TopDockWidgetArea))
         self.console_dock = self._dock("Python Console", self.console, Qt.DockWidgetArea.BottomDockWidgetArea)
         self.console_dock.hide()
-        self.tabifyDockWidget(docks[1], docks[-1])  # beside the ribbon's display options
+        self.tabifyDockWidget(docks[1], docks[5])  # the surface beside the ribbon's display options
         docks[1].raise_()
         self.tabifyDockWidget(docks[2], docks[3])  # validation and history share a place: the window stays small
         self.tabifyDockWidget(docks[2], docks[4])  # and the compared structures
@@ -136,6 +147,7 @@ class MainWindow(QMainWindow):
         self.document.levelChanged.connect(self._update_status)
         self.document.segmentChanged.connect(self._update_status)
         self.document.picked.connect(self._update_status)
+        self.document.selectionChanged.connect(self._update_status)
         self.document.picked.connect(self._update_regularize_action)
         self._update_title()
         self._update_status()
@@ -399,6 +411,8 @@ class MainWindow(QMainWindow):
         self.regularize_action.setToolTip("Ideal peptide junctions and no new clashes for the residues of the picked "
                                           "point and three on each side (one undo step)")
         self.regularize_action.setEnabled(False)
+        self.go_to_action = self._action("&Go to Residue…", QKeySequence("Ctrl+L"), self._focus_go_to)
+        self.go_to_action.setToolTip("Select a residue or a range and centre the view on it: A:45, 45, A:40-50")
         self.reset_view_action = self._action("&Reset View", QKeySequence("Ctrl+R"), self._reset_view,
                                               icon(pixmap.SP_BrowserReload))
         self.mode_actions = QActionGroup(self)
@@ -439,7 +453,7 @@ class MainWindow(QMainWindow):
         edit_menu.addSeparator()
         edit_menu.addAction(self.regularize_action)
         view_menu = menu.addMenu("&View")
-        view_menu.addAction(self.reset_view_action)
+        view_menu.addActions([self.reset_view_action, self.go_to_action])
         view_menu.addSeparator()
         view_menu.addActions([dock.toggleViewAction() for dock in docks])
         view_menu.addSeparator()
@@ -456,9 +470,16 @@ class MainWindow(QMainWindow):
         toolbar.addActions(self.mode_actions.actions())
         toolbar.addSeparator()
         toolbar.addAction(self.reset_view_action)
+        self.go_to_field = QLineEdit()
+        self.go_to_field.setPlaceholderText("Go to residue (Ctrl+L)")
+        self.go_to_field.setToolTip(self.go_to_action.toolTip())
+        self.go_to_field.setClearButtonEnabled(True)
+        self.go_to_field.setMaximumWidth(190)
+        self.go_to_field.returnPressed.connect(self._go_to_typed)
+        toolbar.addWidget(self.go_to_field)
 
     def _create_status_bar(self) -> None:
-        self.status_labels = {key: QLabel() for key in ("file", "segment", "level", "pick")}
+        self.status_labels = {key: QLabel() for key in ("file", "segment", "level", "pick", "hover")}
         for key, label in self.status_labels.items():
             self.statusBar().addWidget(label, 1 if key == "pick" else 0)
 
@@ -495,23 +516,112 @@ class MainWindow(QMainWindow):
         style.AddObserver("EndInteractionEvent", lambda *_: self._end_interaction())
 
     def _end_interaction(self) -> None:
+        """The camera's gesture ended; one that moved less than a click's pixels was a click."""
         self.plotter.renderer.SetUseFXAA(True)
+        x, y = self.plotter.iren.interactor.GetEventPosition()
+        press, self._press_at = self._press_at, None
+        if press is not None and max(abs(x - press[0]), abs(y - press[1])) < CLICK_PIXELS:
+            self._click(self.pointer.event_at("release", x, y))
         self.plotter.render()
 
     # ------------------------------------------------------------------ slots
 
     def _on_pointer(self, event: PointerEvent) -> bool:
+        if event.kind == "press" and event.double:
+            self._centre_on_pointer(event)
+            return True
+        if event.kind == "move" and not self.controller.dragging:
+            if self._press_at is None:
+                self._hover(event)
+            return False
         grabs = Layer.CONTROL_POINTS if self.controller.mode is Mode.POINT else Layer.CURVE
         if event.kind == "press" and grabs not in self.scene.layers:
-            return False  # what is hidden cannot be grabbed: the press turns the camera
-        if event.kind == "release" and self.controller.dragging:
+            used = False  # what is hidden cannot be grabbed: the press turns the camera
+        elif event.kind == "release" and self.controller.dragging:
             self.plotter.renderer.SetUseFXAA(True)  # the frame after the drag is a still one
             with _busy():  # the release regularizes: a hard edit takes a few tenths of a second
                 return self.controller.handle(event)
-        used = self.controller.handle(event)
-        if used and event.kind == "press":
-            self.plotter.renderer.SetUseFXAA(False)
+        else:
+            self.controller.point_radius = self.scene.point_radius  # as drawn
+            used = self.controller.handle(event)
+        if event.kind == "press":
+            # a press the camera takes: its release ends the camera's interaction (the camera
+            # style holds the interactor's focus until then, so no release comes here)
+            self._press_at = None if used else self.plotter.iren.interactor.GetEventPosition()
+            if used:
+                self.plotter.renderer.SetUseFXAA(False)
         return used
+
+    def _hit(self, event: PointerEvent) -> Hit | None:
+        """What is drawn under the pointer of ``event``."""
+        return identify(self.document, event, points=Layer.CONTROL_POINTS in self.scene.layers,
+                        point_radius=self.scene.point_radius, atoms=self.scene.shown_atoms())
+
+    def _hover(self, event: PointerEvent) -> None:
+        """Name what is under the pointer in a tooltip and the status bar (when it changes)."""
+        hit = self._hit(event) if self.document.model is not None else None
+        text = None if hit is None else describe(self.document, hit)
+        if text == self._hovered:
+            return
+        self._hovered = text
+        self.status_labels["hover"].setText(text or "")
+        if text is None:
+            QToolTip.hideText()
+        else:
+            QToolTip.showText(QCursor.pos(), text, self.plotter)
+
+    def _click(self, event: PointerEvent) -> None:
+        """A click that no drag took: select the residue under the pointer; one of another
+        chain also becomes the edited segment (framed)."""
+        hit = self._hit(event)
+        if hit is None or hit.row < 0 or hit.kind == "point":
+            return
+        segment = self.document.segment_of(hit.row)
+        if segment != self.document.segment:
+            self.document.set_segment(segment)
+        self.document.select([hit.row])
+
+    def _centre_on_pointer(self, event: PointerEvent) -> None:
+        """Double click: turn the view about what is under the pointer (and select its residue)."""
+        hit = self._hit(event)
+        if hit is None:
+            return
+        if hit.row >= 0 and hit.kind != "point":
+            self.document.select([hit.row])
+        self.scene.centre_on(hit.position)
+        self.plotter.render()
+
+    def select_and_centre(self, rows: np.ndarray) -> None:
+        """Select residues ``rows`` (residue-table rows), make their segment the edited one and
+        centre the view on them."""
+        rows = np.asarray(rows, dtype=np.int64)
+        if not len(rows):
+            return
+        segment = self.document.segment_of(int(rows[0]))
+        if segment != self.document.segment:
+            self.document.set_segment(segment)
+        self.document.select(rows)
+        self.scene.centre_on(self.document.model.coords[self.document.ca_rows[rows]].mean(axis=0))
+        self.plotter.render()
+
+    def go_to(self, text: str) -> np.ndarray:
+        """Select and centre on the residues named by ``text`` (``A:45``, ``45`` in the edited
+        chain, ``A:40-50``); returns their residue-table rows (raises ValueError)."""
+        if self.document.model is None:
+            raise ValueError("no structure is open")
+        chain = self.document.structure.segments[self.document.segment].chain
+        rows = find_residues(self.document.structure, text, chain)
+        self.select_and_centre(rows)
+        return rows
+
+    def _go_to_typed(self) -> None:
+        try:
+            self.go_to(self.go_to_field.text())
+        except ValueError as error:
+            self.statusBar().showMessage(str(error), 8000)
+            self.go_to_field.selectAll()
+            return
+        self.plotter.setFocus()  # the keys act on the view again
 
     def _set_mode(self, mode: Mode) -> None:
         self.controller.mode = mode
@@ -522,6 +632,7 @@ class MainWindow(QMainWindow):
             self.controller.cancel()
         elif self.document.model is not None:
             self.document.pick_point(None)
+            self.document.select([])
 
     def _regularize_region(self) -> None:
         if self.document.pick is not None:
@@ -530,6 +641,10 @@ class MainWindow(QMainWindow):
 
     def _update_regularize_action(self) -> None:
         self.regularize_action.setEnabled(self.document.pick is not None)
+
+    def _focus_go_to(self) -> None:
+        self.go_to_field.setFocus()
+        self.go_to_field.selectAll()
 
     def _reset_view(self) -> None:
         self.scene.reset_camera()
@@ -632,6 +747,11 @@ class MainWindow(QMainWindow):
         labels["segment"].setText(f"chain {document.segment_label(document.segment)}")
         labels["level"].setText(f"level {document.shown_level():.2f} / {document.max_level:.2f}")
         pick = document.pick
+        if len(document.selection) and pick is None:
+            first, last = (document.row_label(int(r)) for r in document.selection[[0, -1]])
+            labels["pick"].setText(f"selected {first if first == last else f'{first}–{last}'} "
+                                   f"({len(document.selection)} residues); Esc clears")
+            return
         idle = ("Click a control point to pick it; drag it to edit." if self.controller.mode is Mode.POINT
                 else "Drag the curve to tug it.")
         labels["pick"].setText(

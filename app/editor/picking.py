@@ -44,7 +44,7 @@ class PointerAdapter:
             self._interactor.RemoveObserver(tag)
         self._tags.clear()
 
-    def event_at(self, kind: str, x: int, y: int) -> PointerEvent:
+    def event_at(self, kind: str, x: int, y: int, *, shift: bool = False, double: bool = False) -> PointerEvent:
         """The pointer event at display position (x, y) (VTK pixels, origin bottom left)."""
         renderer = self.plotter.renderer
         near, far = _world(renderer, x, y, 0.0), _world(renderer, x, y, 1.0)
@@ -53,10 +53,11 @@ class PointerAdapter:
         view = np.array(camera.GetDirectionOfProjection())
         height = max(renderer.GetSize()[1], 1)
         if camera.GetParallelProjection():
-            return PointerEvent(kind, near, direction, view, 2.0 * camera.GetParallelScale() / height, 0.0)
+            return PointerEvent(kind, near, direction, view, 2.0 * camera.GetParallelScale() / height, 0.0, shift, double)
         per_depth = 2.0 * math.tan(math.radians(camera.GetViewAngle()) / 2.0) / height
         eye_distance = float((near - np.array(camera.GetPosition())) @ view)
-        return PointerEvent(kind, near, direction, view, per_depth * eye_distance, per_depth * float(direction @ view))
+        return PointerEvent(kind, near, direction, view, per_depth * eye_distance, per_depth * float(direction @ view),
+                            shift, double)
 
     def _observer(self, kind: str) -> Callable[[object, str], None]:
         def observe(interactor: object, _name: str) -> None:
@@ -66,7 +67,9 @@ class PointerAdapter:
 
     def _dispatch(self, interactor: object, kind: str) -> None:
         x, y = interactor.GetEventPosition()  # type: ignore[attr-defined]
-        if self.handler(self.event_at(kind, x, y)):
+        event = self.event_at(kind, x, y, shift=bool(interactor.GetShiftKey()),  # type: ignore[attr-defined]
+                              double=kind == "press" and interactor.GetRepeatCount() > 0)  # type: ignore[attr-defined]
+        if self.handler(event):
             interactor.GetCommand(self._tags[kind]).SetAbortFlag(1)  # type: ignore[attr-defined]
 
 

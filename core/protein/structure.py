@@ -101,6 +101,17 @@ class BackboneSegment:
             for name, num, ic in zip(self.resname, self.resseq.tolist(), self.icode, strict=True)
         )
 
+    @cached_property
+    def sequence(self) -> str:
+        """One-letter codes of the residues (modified ones as their parent, 'X' if unknown)."""
+        return "".join(_one_letter(name) for name in self.resname)
+
+
+def _one_letter(name: str) -> str:
+    residue = gemmi.find_tabulated_residue(name)
+    code = residue.one_letter_code.upper() if residue is not None else " "
+    return code if code.strip() else "X"
+
 
 @dataclass(frozen=True)
 class ChainSummary:

@@ -27,7 +27,7 @@ from PySide6.QtWidgets import (
 from app.editor.document import Change, Document
 from app.editor.scene import molecule
 from app.editor.scene.molecule import Colouring
-from app.editor.scene.scene import Layer, Scene
+from app.editor.scene.scene import DIM_ABOVE_CHAINS, Layer, Others, Scene
 from core.protein.ribbon import RibbonKind
 
 STEPS_PER_LEVEL = 100
@@ -189,6 +189,11 @@ class DisplayPanel(QWidget):
         for colouring in Colouring:
             self.colouring.addItem(colouring.value[0].upper() + colouring.value[1:], colouring)
         self.fat = QCheckBox("Fat helices (radius by secondary structure)")
+        self.others = QComboBox()
+        for others in Others:
+            self.others.addItem(f"Other chains {others.value}", others)
+        self.others.setToolTip("How the chains other than the edited one are drawn (dimmed at first in entries "
+                               f"of more than {DIM_ABOVE_CHAINS} chains)")
         self.legend = QWidget()
         self.legend_layout = QFormLayout(self.legend)
         self.legend_layout.setContentsMargins(0, 0, 0, 0)
@@ -196,6 +201,7 @@ class DisplayPanel(QWidget):
         colour_box = QVBoxLayout(colours)
         colour_box.addWidget(self.colouring)
         colour_box.addWidget(self.fat)
+        colour_box.addWidget(self.others)
         colour_box.addWidget(self.legend)
         layout = QVBoxLayout(self)
         layout.addWidget(layers)
@@ -203,6 +209,7 @@ class DisplayPanel(QWidget):
         layout.addStretch(1)
         self.colouring.currentIndexChanged.connect(self._colouring_changed)
         self.fat.toggled.connect(scene.set_fat_helices)
+        self.others.currentIndexChanged.connect(lambda: scene.set_others(self.others.currentData()))
         scene.document.loaded.connect(self._update_legend)
         if scene.document.model is not None:
             self._update_legend()
@@ -212,6 +219,8 @@ class DisplayPanel(QWidget):
         self._update_legend()
 
     def _update_legend(self) -> None:
+        with QSignalBlocker(self.others):  # a new structure: the scene chose how to draw the other chains
+            self.others.setCurrentIndex(self.others.findData(self.scene.others))
         while self.legend_layout.rowCount():
             self.legend_layout.removeRow(0)
         for name, rgb in molecule.legend(self.scene.document.structure, self.scene.colouring):

@@ -18,7 +18,7 @@ from PySide6.QtCore import QObject
 from vtkmodules.util.numpy_support import vtk_to_numpy
 
 from app.editor.document import Change, Document, Pick
-from app.editor.drag import HANDLE_RADIUS
+from app.editor.drag import HANDLE_BOX, HANDLE_RADIUS
 from app.editor.scene import molecule, tube
 from app.editor.scene.molecule import Colouring
 
@@ -30,13 +30,19 @@ FAT_RADII = {"H": 1.5, "E": 1.8, "C": 0.45}
 CA_RADIUS = 0.45
 LIGAND_ATOM_RADIUS = 0.35
 ION_RADIUS = 1.1
-HANDLE_BOX = 2.2 * HANDLE_RADIUS
-"""Edge of the handle box around the picked control point, Å."""
+POINT_SPACING_FRACTION = 0.12
+"""Control-point spheres have this fraction of the level's median control-point spacing as
+radius (at least HANDLE_RADIUS)..."""
+MIN_POINT_PIXELS = 6.0
+"""... and never less than this on screen (pixels), however far the camera is."""
 
 CURVE_COLOUR = (40, 44, 52)
 OTHER_CURVE_COLOUR = (120, 126, 136)
 POINT_COLOUR = (140, 90, 220)
 PICKED_COLOUR = (0, 170, 255)
+SELECTION_COLOUR = (240, 40, 220)
+SELECTION_RADIUS = 1.4
+"""Å, the translucent balls around the Cα of selected residues."""
 POLYGON_COLOUR = (110, 110, 120)
 CA_STICK_COLOUR = (120, 124, 130)
 CAPTION_COLOUR = "#2b2f36"
@@ -55,6 +61,21 @@ class Layer(StrEnum):
     IONS = "ions"
     VALIDATION = "validation markers"
 
+
+class Others(StrEnum):
+    """How the chains other than the edited one are drawn."""
+
+    SHOWN = "shown"
+    DIMMED = "dimmed"
+    HIDDEN = "hidden"
+
+
+DIM_TOWARD_WHITE = 0.7
+"""Dimmed chains take this fraction of the way from their colour to white."""
+DIM_ABOVE_CHAINS = 4
+"""Entries with more chains than this open with the other chains dimmed."""
+CONCEALED = ("tube", "curve", "ca_balls", "ca_sticks", "atoms", "ligand_sticks", "ions", "ligand_balls")
+"""The meshes whose other chains are hidden."""
 
 DEFAULT_LAYERS = {Layer.TUBE, Layer.CURVE, Layer.CONTROL_POINTS, Layer.LIGANDS, Layer.IONS, Layer.VALIDATION}
 
@@ -81,6 +102,10 @@ class Scene(QObject):
         self.layers = set(DEFAULT_LAYERS)
         self.colouring = Colouring.SECONDARY_STRUCTURE
         self.fat_helices = False
+        self.others = Others.SHOWN
+        self._concealed = False
+        self.point_radius = HANDLE_RADIUS
+        """Radius of the control-point spheres, Å."""
         self.meshes: dict[str, pv.PolyData] = {}
         self.actors: dict[str, pv.Actor] = {}
         sphere = pv.Icosphere(radius=1.0, nsub=1)
@@ -90,11 +115,13 @@ class Scene(QObject):
         self._shown_xyz = np.empty((0, 3))
         self._shown_pick: Pick | None = None
         plotter.set_background(BACKGROUND[0], top=BACKGROUND[1])
+        plotter.renderer.AddObserver("StartEvent", lambda *_: self._size_points())
         document.loaded.connect(self._build)
         document.changed.connect(self._on_change)
         document.levelChanged.connect(self._on_level)
         document.segmentChanged.connect(self._on_segment)
         document.picked.connect(self._on_pick)
+        document.selectionChanged.connect(self._on_selection)
         if document.model is not None:
             self._build()
 
@@ -112,9 +139,7 @@ class Scene(QObject):
         """Colour the tube and the Cα trace by secondary structure, residue type or chain."""
         self.colouring = Colouring(colouring)
         if self.document.model is not None:
-            colours = molecule.residue_colours(self.document.structure, self.colouring)
-            self._tube_colours(colours)
-            self._write("ca_balls", slice(None), np.repeat(colours, len(self._sphere), axis=0), "colours")
+            self._residue_colours_changed()
             self.plotter.render()
 
     def set_fat_helices(self, on: bool) -> None:
@@ -124,6 +149,14 @@ class Scene(QObject):
             self._ring_radii = self._radii()
             for segment in range(len(self.document.paths)):
                 self._sweep(segment, slice(None))
+            self._conceal()
+            self.plotter.render()
+
+    def set_others(self, others: Others | str) -> None:
+        """Show, dim or hide the chains other than the edited segment's."""
+        self.others = Others(others)
+        if self.document.model is not None:
+            self._draw_others()
             self.plotter.render()
 
     def reset_camera(self) -> None:
@@ -143,6 +176,27 @@ class Scene(QObject):
         low, high = ca.min(axis=0) - 2.0, ca.max(axis=0) + 2.0
         self.plotter.renderer.ResetCamera(low[0], high[0], low[1], high[1], low[2], high[2])
 
+    def centre_on(self, point: np.ndarray) -> None:
+        """Turn the view about ``point`` (Å) from now on and bring it to the centre of the view:
+        the camera keeps its direction and distance."""
+        camera = self.plotter.renderer.GetActiveCamera()
+        offset = np.asarray(point, dtype=float) - np.array(camera.GetFocalPoint())
+        camera.SetFocalPoint(*(np.array(camera.GetFocalPoint()) + offset))
+        camera.SetPosition(*(np.array(camera.GetPosition()) + offset))
+        self.plotter.renderer.ResetCameraClippingRange()
+
+    def frame_residues(self, rows: np.ndarray, margin: float = 8.0) -> None:
+        """Centre the view on residues ``rows`` (residue-table rows) and fit them, with
+        ``margin`` Å around, looking from where the camera is."""
+        ca = self.document.model.coords[self.document.ca_rows[np.asarray(rows)]]
+        low, high = ca.min(axis=0) - margin, ca.max(axis=0) + margin
+        self.plotter.renderer.ResetCamera(low[0], high[0], low[1], high[1], low[2], high[2])
+
+    def shown_atoms(self) -> np.ndarray:
+        """Rows of the coordinates of the atoms drawn now (polymer atoms, ligands, ions)."""
+        rows = [rows for layer, rows in self._atom_rows.items() if layer in self.layers]
+        return np.concatenate(rows) if rows else np.empty(0, dtype=np.int64)
+
     def shown_control_points(self) -> np.ndarray:
         """Indices (into the level curve's control points) of the spheres on screen."""
         return self._shown_points
@@ -155,14 +209,21 @@ class Scene(QObject):
         self.meshes.clear()
         self.actors.clear()
         self._residue_offset = np.array([s.residue_index[0] for s in structure.segments])
+        self._residue_chain = np.concatenate([np.full(len(s), s.chain) for s in structure.segments])
+        self.others = Others.DIMMED if len(set(self._residue_chain)) > DIM_ABOVE_CHAINS else Others.SHOWN
+        self._concealed = False
         self._build_tube()
         self._build_curve()
         self._build_ca_trace()
         self._build_atoms()
         self._shown_points = np.empty(0, dtype=np.int64)
         self._update_control_points()
+        self.meshes["selection"] = pv.PolyData()
+        self._on_selection(render=False)
         self._show_layers()
         self._update_caption()
+        if self.others is not Others.SHOWN:
+            self._draw_others()
         self.reset_camera()
         self.plotter.render()
 
@@ -190,7 +251,7 @@ class Scene(QObject):
         self.meshes["tube"] = mesh
         for segment in range(len(paths)):
             self._sweep(segment, slice(None))
-        self._tube_colours(molecule.residue_colours(self.document.structure, self.colouring))
+        self._tube_colours(self._residue_colours())
         self._add("tube", scalars="colours", rgb=True, interpolation="phong", specular=0.35, specular_power=25.0,
                   diffuse=0.8, ambient=0.18)
 
@@ -205,7 +266,7 @@ class Scene(QObject):
     def _build_ca_trace(self) -> None:
         structure = self.document.structure
         ca = self.document.model.coords[self.document.ca_rows]
-        self.meshes["ca_balls"] = self._glyphs(ca, CA_RADIUS, molecule.residue_colours(structure, self.colouring))
+        self.meshes["ca_balls"] = self._glyphs(ca, CA_RADIUS, self._residue_colours())
         self._add("ca_balls", scalars="colours", rgb=True, **_SHINY)
         bounds = np.cumsum([0] + [len(s) for s in structure.segments])
         self.meshes["ca_sticks"] = pv.PolyData(ca.copy(), lines=_polylines(bounds))
@@ -216,10 +277,12 @@ class Scene(QObject):
         table = structure.atoms
         coords = self.document.model.coords
         polymer = np.flatnonzero(np.isin(table.category, ("protein", "nucleic")))
+        self._atom_colours = molecule.element_colours(table.element)
         self.meshes["atoms"] = _bond_lines(coords, molecule.bonds(coords, table.element, table.altloc, polymer),
-                                           molecule.element_colours(table.element))
+                                           self._atom_colours)
         self._add("atoms", scalars="colours", rgb=True, line_width=1.5)
         ions, ligands = molecule.ions_and_ligands(structure)
+        self._atom_rows = {Layer.ATOMS: polymer, Layer.LIGANDS: ligands, Layer.IONS: ions}
         self.meshes["ions"] = self._glyphs(coords[ions], ION_RADIUS, molecule.element_colours(table.element[ions]))
         self._add("ions", scalars="colours", rgb=True, **_SHINY)
         carbon = molecule.LIGAND_CARBON
@@ -249,12 +312,109 @@ class Scene(QObject):
         self._write("curve", curve, self.document.level_curve(segment).samples)
         if segment == self.document.segment:
             self._update_control_points()
+        if len(self.document.selection):
+            self._move_glyphs("selection", slice(None), model.coords[self.document.ca_rows[self.document.selection]])
+        if self._residue_chain[self._residue_offset[segment]] != self._chain():  # an undo in a hidden chain
+            self._conceal()
         self.plotter.render()
+
+    def _on_selection(self, render: bool = True) -> None:
+        """Translucent balls around the selected residues' Cα (one small mesh, rebuilt)."""
+        rows = self.document.selection
+        ca = self.document.model.coords[self.document.ca_rows[rows]]
+        colours = np.tile(np.array(SELECTION_COLOUR, dtype=np.uint8), (len(rows), 1))
+        self.meshes["selection"].shallow_copy(self._glyphs(ca, SELECTION_RADIUS, colours))
+        if "selection" not in self.actors and len(rows):
+            self._add("selection", scalars="colours", rgb=True, opacity=0.45, **_SHINY)
+        if render:
+            self.plotter.render()
 
     def _on_segment(self) -> None:
         self._colour_curves()
+        if self.others is not Others.SHOWN:
+            self._draw_others()
         self.frame_segment()
         self._on_level()
+
+    def _chain(self) -> str:
+        """The edited segment's chain."""
+        return self.document.structure.segments[self.document.segment].chain
+
+    def _residue_colours(self) -> np.ndarray:
+        """Every residue's colour in the scheme, the other chains' faded when they are dimmed."""
+        colours = molecule.residue_colours(self.document.structure, self.colouring)
+        if self.others is Others.DIMMED:
+            colours = _faded(colours, self._residue_chain != self._chain())
+        return colours
+
+    def _residue_colours_changed(self) -> None:
+        colours = self._residue_colours()
+        self._tube_colours(colours)
+        self._write("ca_balls", slice(None), np.repeat(colours, len(self._sphere), axis=0), "colours")
+
+    def _draw_others(self) -> None:
+        """Colours and positions of every chain as :attr:`others` says (after a change of it
+        or of the edited chain)."""
+        self._residue_colours_changed()
+        if self.meshes["atoms"].n_points:
+            table = self.document.structure.atoms
+            fade = self.others is Others.DIMMED
+            self._write("atoms", slice(None), _faded(self._atom_colours, fade & (table.chain != self._chain())),
+                        "colours")
+        if self._concealed:  # put every vertex back where the model has it
+            model = self.document.model
+            for segment in range(len(self.document.paths)):
+                self._sweep(segment, slice(None))
+            ca = model.coords[self.document.ca_rows]
+            self._move_glyphs("ca_balls", slice(None), ca)
+            self._write("ca_sticks", slice(None), ca)
+            ions, ligands = self._atom_rows[Layer.IONS], self._atom_rows[Layer.LIGANDS]
+            for name, centres in (("ions", model.coords[ions]), ("ligand_balls", model.coords[ligands])):
+                if self.meshes[name].n_points:
+                    self._move_glyphs(name, slice(None), centres)
+            for name in ("atoms", "ligand_sticks"):
+                if self.meshes[name].n_points:
+                    self._write(name, slice(None), model.coords)
+            self._write("curve", slice(None), np.vstack([self.document.level_curve(g).samples
+                                                         for g in range(len(self.document.paths))]))
+            self._concealed = False
+        self._conceal()
+
+    def _conceal(self, names: tuple[str, ...] = CONCEALED) -> None:
+        """With :attr:`others` hidden, collapse the other chains' vertices in meshes ``names``
+        onto one point each: their faces and lines then cover no pixel."""
+        if self.others is not Others.HIDDEN:
+            return
+        self._concealed = True
+        chain = self._chain()
+        for segment, path in enumerate(self.document.paths):
+            first = self._residue_offset[segment]
+            if self._residue_chain[first] == chain:
+                continue
+            n_residues = len(self.document.structure.segments[segment])
+            rows = {"tube": _shift(slice(None), self._ring_start[segment], path.n_rings, TUBE_SIDES),
+                    "curve": slice(self._curve_start[segment], self._curve_start[segment + 1]),
+                    "ca_balls": _shift(slice(None), first, n_residues, len(self._sphere)),
+                    "ca_sticks": slice(first, first + n_residues)}
+            for name in names:
+                if name in rows:
+                    self._collapse(name, rows[name])
+            if "tube" in names:
+                caps = slice(self._cap_start[segment], self._cap_start[segment] + 2 * (TUBE_SIDES + 1))
+                self._collapse("tube", caps)
+        other = self.document.structure.atoms.chain != chain
+        for name in ("atoms", "ligand_sticks"):
+            if name in names and self.meshes[name].n_points:
+                self._collapse(name, np.flatnonzero(other))
+        for name, layer in (("ions", Layer.IONS), ("ligand_balls", Layer.LIGANDS)):
+            rows = np.flatnonzero(other[self._atom_rows[layer]])
+            if name in names and len(rows):
+                self._collapse(name, _shift(rows, 0, len(self._atom_rows[layer]), len(self._sphere)))
+
+    def _collapse(self, name: str, rows: np.ndarray | slice) -> None:
+        points = vtk_to_numpy(self.meshes[name].GetPoints().GetData())
+        if len(points[rows]):
+            self._write(name, rows, points[rows][0])
 
     def _colour_curves(self) -> None:
         """The level curve of the edited segment in a dark colour, the others lighter."""
@@ -266,6 +426,7 @@ class Scene(QObject):
     def _on_level(self) -> None:
         samples = np.vstack([self.document.level_curve(g).samples for g in range(len(self.document.paths))])
         self._write("curve", slice(None), samples)
+        self._conceal(("curve",))
         self._update_control_points()
         self._update_caption()
         self.plotter.render()
@@ -274,7 +435,26 @@ class Scene(QObject):
         self._update_control_points()
         self.plotter.render()
 
-    def _update_control_points(self) -> None:
+    def _size_points(self) -> None:
+        """Before each frame: resize the control-point spheres and the handle box when the
+        level's spacing or the camera's distance asks for another size (by more than 5%)."""
+        if "control_points" not in self.meshes or not len(self._shown_xyz):
+            return
+        points = self._shown_xyz
+        spacing = float(np.median(np.linalg.norm(np.diff(points, axis=0), axis=1))) if len(points) > 1 else 0.0
+        camera = self.plotter.renderer.GetActiveCamera()
+        height = max(self.plotter.renderer.GetSize()[1], 1)
+        if camera.GetParallelProjection():
+            pixel = 2.0 * camera.GetParallelScale() / height
+        else:
+            depth = float((points.mean(axis=0) - np.array(camera.GetPosition())) @ camera.GetDirectionOfProjection())
+            pixel = 2.0 * np.tan(np.radians(camera.GetViewAngle()) / 2.0) * max(depth, 0.0) / height
+        radius = max(HANDLE_RADIUS, POINT_SPACING_FRACTION * spacing, MIN_POINT_PIXELS * pixel)
+        if abs(radius - self.point_radius) > 0.05 * self.point_radius:
+            self.point_radius = radius
+            self._update_control_points(resized=True)
+
+    def _update_control_points(self, resized: bool = False) -> None:
         curve = self.document.level_curve()
         shown = np.flatnonzero(curve.visible)
         points = curve.control_points[shown]
@@ -282,22 +462,23 @@ class Scene(QObject):
         colours = np.tile(np.array(POINT_COLOUR, dtype=np.uint8), (len(shown), 1))
         if pick is not None:
             colours[shown == pick.index] = PICKED_COLOUR
-        if len(shown) == len(self._shown_points):  # rewrite only the spheres that moved or changed colour
+        if len(shown) == len(self._shown_points) and not resized:  # rewrite the spheres that moved or changed colour
             moved = _span(np.flatnonzero(np.any(points != self._shown_xyz, axis=1)))
             self._move_glyphs("control_points", moved, points[moved])
             self._write("control_polygon", moved, points[moved])
             if pick is not self._shown_pick:
                 self._write("control_points", slice(None), np.repeat(colours, len(self._sphere), axis=0), "colours")
-        elif "control_points" in self.meshes:  # another level: new glyph data under the same actors
-            self.meshes["control_points"].shallow_copy(self._glyphs(points, HANDLE_RADIUS, colours))
+        elif "control_points" in self.meshes:  # another level or size: new glyph data under the same actors
+            self.meshes["control_points"].shallow_copy(self._glyphs(points, self.point_radius, colours))
             self.meshes["control_polygon"].shallow_copy(_polyline(points))
+            self._box_corners = np.array(_box_edges(HANDLE_BOX * self.point_radius).points)
         else:
-            self.meshes["control_points"] = self._glyphs(points, HANDLE_RADIUS, colours)
+            self.meshes["control_points"] = self._glyphs(points, self.point_radius, colours)
             self._add("control_points", scalars="colours", rgb=True, interpolation="phong", specular=0.5,
                       specular_power=30.0)
             self.meshes["control_polygon"] = _polyline(points)
             self._add("control_polygon", color=POLYGON_COLOUR, line_width=1.5)
-            self.meshes["handle"] = _box_edges(HANDLE_BOX)
+            self.meshes["handle"] = _box_edges(HANDLE_BOX * self.point_radius)
             self._add("handle", color=PICKED_COLOUR, line_width=2.0, render_lines_as_tubes=True)
             self._box_corners = np.array(self.meshes["handle"].points)
         self._shown_points, self._shown_xyz, self._shown_pick = shown, points, pick
@@ -405,6 +586,13 @@ class Scene(QObject):
                     self.actors[name].SetVisibility(layer in self.layers)
         if "handle" in self.actors:
             self.actors["handle"].SetVisibility(self.document.pick is not None and Layer.CONTROL_POINTS in self.layers)
+
+
+def _faded(colours: np.ndarray, which: np.ndarray) -> np.ndarray:
+    """(n, 3) uint8 ``colours`` with rows ``which`` (a mask) taken toward white."""
+    colours = np.array(colours, dtype=np.uint8)
+    colours[which] = np.rint(colours[which] + DIM_TOWARD_WHITE * (255 - colours[which].astype(float)))
+    return colours
 
 
 def _span(indices: np.ndarray) -> np.ndarray | slice:

@@ -11,6 +11,7 @@ from app.editor.commands import EditCommand
 from app.editor.docks.surfaces import COLOURING_NAMES, KIND_NAMES, STEPS_PER_LEVEL, SurfacePanel
 from app.editor.document import Document
 from app.editor.main_window import MainWindow
+from app.editor.scene.scene import Layer
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 BUILD_TIMEOUT_MS = 120_000
@@ -73,6 +74,7 @@ def test_globe_levels_colourings_and_screenshot(qtbot: QtBot, ubiquitin: Documen
     assert panel.layer.shown_level() == 3.5 and not np.array_equal(mesh.points, shapes[3])
 
     panel.slider.setValue(3 * STEPS_PER_LEVEL)
+    window.scene.set_layer(Layer.CONTROL_POINTS, False)  # their purple would count as blue
     images = {}
     for colouring in COLOURING_NAMES:
         panel.colouring.setCurrentIndex(list(COLOURING_NAMES).index(colouring))

@@ -1,0 +1,158 @@
+"""The sequence bar: the edited segment's one-letter codes along the view.
+
+Each residue is a cell coloured by secondary structure, numbered every ten residues; the
+residues the picked control point moves are underlined in the pick's colour and the
+selected ones framed in the selection's colour. A click (or a drag across cells) asks for
+those residues to be selected and centred (:attr:`SequenceBar.residuesActivated`, which the
+window connects); Shift extends the selection. Hovering names the residue.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import QPoint, QRect, QSize, Qt, Signal
+from PySide6.QtGui import QColor, QFont, QFontDatabase, QMouseEvent, QPainter, QPaintEvent
+from PySide6.QtWidgets import QScrollArea, QToolTip, QWidget
+
+from app.editor.document import Document
+from app.editor.scene.molecule import SS_COLOURS, SS_NAMES
+from app.editor.scene.scene import PICKED_COLOUR, SELECTION_COLOUR
+
+NUMBER_EVERY = 10
+
+
+class SequenceStrip(QWidget):
+    """The painted row of residue cells of the document's current segment."""
+
+    residuesActivated = Signal(object)
+    """Residue-table rows (an array) to select and centre on."""
+
+    def __init__(self, document: Document, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.document = document
+        font = QFontDatabase.systemFont(QFontDatabase.SystemFont.FixedFont)
+        font.setPointSize(max(font.pointSize(), 9))
+        font.setWeight(QFont.Weight.DemiBold)
+        self.setFont(font)
+        metrics = self.fontMetrics()
+        self.cell = metrics.horizontalAdvance("W") + 4
+        self.row_height = metrics.height() + 4
+        self.setMouseTracking(True)
+        self._anchor: int | None = None
+        for signal in (document.loaded, document.segmentChanged, document.picked, document.selectionChanged,
+                       document.levelChanged):
+            signal.connect(self._refresh)
+        self._refresh()
+
+    def sizeHint(self) -> QSize:
+        return QSize(self._count() * self.cell + 8, 2 * self.row_height + 6)
+
+    def minimumSizeHint(self) -> QSize:
+        return self.sizeHint()
+
+    def cell_rect(self, residue: int) -> QRect:
+        """Where residue ``residue`` (index within the segment) is drawn."""
+        return QRect(4 + residue * self.cell, self.row_height + 2, self.cell - 1, self.row_height)
+
+    def residue_at(self, x: int) -> int | None:
+        """The residue (index within the segment) at ``x`` pixels, or None."""
+        k = (x - 4) // self.cell
+        return int(k) if 0 <= k < self._count() and x >= 4 else None
+
+    def _count(self) -> int:
+        document = self.document
+        return len(document.structure.segments[document.segment]) if document.model is not None else 0
+
+    def _refresh(self) -> None:
+        self.setMinimumSize(self.sizeHint())
+        self.resize(self.sizeHint())
+        self.update()
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        document = self.document
+        if document.model is None:
+            return
+        segment = document.structure.segments[document.segment]
+        start = int(segment.residue_index[0])
+        selected = np.zeros(len(segment), dtype=bool)
+        rows = document.selection[(document.selection >= start) & (document.selection < start + len(segment))]
+        selected[rows - start] = True
+        moved = np.zeros(len(segment), dtype=bool)
+        if document.pick is not None:
+            moved[document.pick.residues] = True
+        painter = QPainter(self)
+        first = max(0, self.residue_at(event.rect().left()) or 0)
+        last = min(len(segment), (event.rect().right() - 4) // self.cell + 2)
+        text = self.palette().windowText().color()
+        for k in range(first, last):
+            cell = self.cell_rect(k)
+            painter.fillRect(cell, QColor(*_light(SS_COLOURS[segment.ss[k]])))
+            if moved[k]:
+                painter.fillRect(QRect(cell.left(), cell.bottom() - 2, cell.width(), 3), QColor(*PICKED_COLOUR))
+            if selected[k]:
+                painter.setPen(QColor(*SELECTION_COLOUR).darker(120))
+                painter.drawRect(cell.adjusted(0, 0, -1, -1))
+            painter.setPen(text)
+            painter.drawText(cell, Qt.AlignmentFlag.AlignCenter, segment.sequence[k])
+            number = int(segment.resseq[k])
+            if number % NUMBER_EVERY == 0 or k == 0 and not np.any(segment.resseq[:3] % NUMBER_EVERY == 0):
+                painter.drawText(QPoint(cell.left(), self.row_height - 2), f"{number}{segment.icode[k]}")
+        painter.end()
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        residue = self.residue_at(int(event.position().x()))
+        if residue is None or event.button() != Qt.MouseButton.LeftButton:
+            return
+        shift = bool(event.modifiers() & Qt.KeyboardModifier.ShiftModifier)
+        if not shift or self._anchor is None:
+            self._anchor = residue
+        self._activate(self._anchor, residue)
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        residue = self.residue_at(int(event.position().x()))
+        if residue is None:
+            return
+        if event.buttons() & Qt.MouseButton.LeftButton and self._anchor is not None:
+            self._activate(self._anchor, residue)
+            return
+        segment = self.document.structure.segments[self.document.segment]
+        QToolTip.showText(event.globalPosition().toPoint(),
+                          f"{segment.labels[residue]} · {SS_NAMES[segment.ss[residue]]}", self)
+
+    def _activate(self, a: int, b: int) -> None:
+        start = int(self.document.structure.segments[self.document.segment].residue_index[0])
+        low, high = sorted((a, b))
+        self.residuesActivated.emit(np.arange(start + low, start + high + 1))
+
+
+class SequenceBar(QScrollArea):
+    """The :class:`SequenceStrip` in a horizontal scroll area that keeps the selection in sight."""
+
+    def __init__(self, document: Document, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.strip = SequenceStrip(document)
+        self.setWidget(self.strip)
+        self.setWidgetResizable(False)
+        self.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.setFixedHeight(self.strip.sizeHint().height() + self.horizontalScrollBar().sizeHint().height() + 4)
+        document.selectionChanged.connect(self._follow)
+        document.picked.connect(self._follow)
+
+    def _follow(self) -> None:
+        """Scroll so the first selected (or picked) residue of the segment is visible."""
+        document = self.strip.document
+        if document.model is None:
+            return
+        segment = document.structure.segments[document.segment]
+        start = int(segment.residue_index[0])
+        rows = document.selection[(document.selection >= start) & (document.selection < start + len(segment))] - start
+        if not len(rows) and document.pick is not None:
+            rows = document.pick.residues
+        if len(rows):
+            cell = self.strip.cell_rect(int(rows[0]))
+            self.ensureVisible(cell.center().x(), cell.center().y(), 3 * self.strip.cell, 0)
+
+
+def _light(rgb: tuple[int, int, int]) -> tuple[int, int, int]:
+    """``rgb`` halfway to white: a cell background that black letters read on."""
+    return tuple(int(c + (255 - c) * 0.55) for c in rgb)  # type: ignore[return-value]

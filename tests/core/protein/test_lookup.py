@@ -1,0 +1,58 @@
+"""Residues named as people type them, on real entries."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.protein.lookup import find_residues
+from core.protein.reading import read_structure
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+
+
+@pytest.fixture(scope="module")
+def haemoglobin():
+    return read_structure(DATA / "4HHB.pdb.gz")
+
+
+def _label(structure, row: int) -> str:
+    segment = next(s for s in structure.segments if s.residue_index[0] <= row <= s.residue_index[-1])
+    return segment.labels[row - segment.residue_index[0]]
+
+
+@pytest.mark.parametrize(("text", "chain", "label"), [
+    ("A:45", None, "A:HIS45"), ("B:45", "A", "B:PHE45"), ("45", "C", "C:HIS45"), ("45", None, "A:HIS45"),
+    ("D45", None, "D:PHE45"), ("B:PHE45", None, "B:PHE45"), ("phe45", "B", "B:PHE45"), (" C / 3 ", None, "C:SER3"),
+])
+def test_one_residue(haemoglobin, text: str, chain: str | None, label: str) -> None:
+    rows = find_residues(haemoglobin, text, chain)
+    assert len(rows) == 1 and _label(haemoglobin, int(rows[0])) == label
+
+
+def test_a_range_in_either_order(haemoglobin) -> None:
+    rows = find_residues(haemoglobin, "B:40-50")
+    assert [_label(haemoglobin, int(r)) for r in rows[[0, -1]]] == ["B:ARG40", "B:THR50"] and len(rows) == 11
+    assert np.array_equal(find_residues(haemoglobin, "B:50..40"), rows)
+
+
+def test_insertion_codes() -> None:
+    trypsin = read_structure(DATA / "3PTB.pdb.gz")
+    segment = trypsin.segments[0]
+    k = int(np.flatnonzero(segment.icode != "")[0])
+    text = f"{segment.chain}:{segment.resseq[k]}{segment.icode[k]}"
+    assert np.array_equal(find_residues(trypsin, text), [segment.residue_index[k]])
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("A:999", "no residue A:999 in chain A"), ("Z:5", "no chain Z"), ("A:ALA45", "no residue A:ALA45"),
+    ("hello world", "cannot read 'hello world'"), ("", "cannot read"),
+])
+def test_clear_messages(haemoglobin, text: str, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        find_residues(haemoglobin, text)
+
+
+def test_one_letter_sequence() -> None:
+    ubiquitin = read_structure(DATA / "1UBQ.pdb.gz")
+    assert ubiquitin.segments[0].sequence == "MQIFVKTLTGKTITLEVEPSDTIENVKAKIQDKEGIPPDQQRLIFAGKQLEDGRTLSDYNIQKESTLHLVLRLRGG"
