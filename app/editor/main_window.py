@@ -49,6 +49,7 @@ from app import EXAMPLES_DIR
 from app.editor.docks.comparison import ComparisonPanel
 from app.editor.docks.console import PythonConsole
 from app.editor.docks.panels import DisplayPanel, RibbonDimensionPanel
+from app.editor.docks.ramachandran import RamachandranPanel
 from app.editor.docks.sequence import SequenceBar
 from app.editor.docks.surfaces import SurfaceLayer, SurfacePanel
 from app.editor.docks.validation import ValidationPanel
@@ -115,6 +116,8 @@ class MainWindow(QMainWindow):
         self.comparison_view = ComparisonView(self.comparison, self.plotter)
         self.comparison_panel = ComparisonPanel(self.comparison)
         self.validation_panel = ValidationPanel(self.validation)
+        self.ramachandran_panel = RamachandranPanel(self.document, self.validation)
+        self.ramachandran_panel.residueActivated.connect(lambda row: self.select_and_centre([row]))
         self.surface_layer = SurfaceLayer(self.document, self.plotter)  # after the scene, which clears the view on load
         self.surface_panel = SurfacePanel(self.surface_layer)
         self.history = QUndoView(self.document.undo_stack)
@@ -136,6 +139,8 @@ class MainWindow(QMainWindow):
         docks[1].raise_()
         self.tabifyDockWidget(docks[2], docks[3])  # validation and history share a place: the window stays small
         self.tabifyDockWidget(docks[2], docks[4])  # and the compared structures
+        docks.append(self._dock("Ramachandran", _scrolled(self.ramachandran_panel)))
+        self.tabifyDockWidget(docks[3], docks[-1])  # beside the validation
         docks[3].raise_()
         self.console_dock.visibilityChanged.connect(self._hide_stale_tab_bars)
         self._create_actions()

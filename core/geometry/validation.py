@@ -245,11 +245,17 @@ def _junction_flags(
     return flags, tuple(int(i) for i in first[cis]), checked
 
 
-def phi_psi(structure: Structure, coords: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """φ and ψ (degrees) of every residue of the residue table, NaN where undefined
-    (segment ends, missing atoms); ``coords`` default to the structure as read."""
+def phi_psi(
+    structure: Structure, coords: np.ndarray | None = None, residues: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """φ and ψ (degrees) of the residue-table rows ``residues`` (default: every residue), NaN
+    where undefined (segment ends, missing atoms); ``coords`` default to the structure as read."""
     top = topology(structure)
-    return _phi_psi(top, structure.coords if coords is None else np.asarray(coords, float), np.arange(len(top.backbone)))
+    n_residues = len(top.backbone)
+    rows = np.arange(n_residues) if residues is None else np.asarray(residues, dtype=np.int64)
+    if rows.size and (rows.min() < 0 or rows.max() >= n_residues):
+        raise ValueError(f"residues must lie in [0, {n_residues - 1}]")
+    return _phi_psi(top, structure.coords if coords is None else np.asarray(coords, float), rows)
 
 
 def _phi_psi(top: Topology, coords: np.ndarray, residues: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -104,6 +104,20 @@ def test_phi_psi_match_gemmi(ubiquitin):
     assert np.isnan(phi[0]) and np.isnan(psi[-1])
 
 
+
+def test_phi_psi_of_some_residues_are_those_of_the_whole_table():
+    structure = read_structure(DATA / "1TIM.pdb.gz")
+    coords = structure.coords + np.random.default_rng(0).normal(scale=0.3, size=structure.coords.shape)
+    phi, psi = phi_psi(structure, coords)
+    rows = structure.segments[1].residue_index[[0, 5, 3, 246]]  # the second chain, its ends included
+    some_phi, some_psi = phi_psi(structure, coords, rows)
+    np.testing.assert_array_equal(some_phi, phi[rows])
+    np.testing.assert_array_equal(some_psi, psi[rows])
+    assert np.isnan(some_phi[0]) and np.isnan(some_psi[-1]) and np.isfinite(some_phi[1:]).all()
+    assert [len(a) for a in phi_psi(structure, coords, np.empty(0, dtype=int))] == [0, 0]
+    with pytest.raises(ValueError, match="residues must lie in"):
+        phi_psi(structure, coords, [structure.n_residues])
+
 def test_ramachandran_regions():
     general, glycine, proline = (RAMACHANDRAN_CLASSES.index(c) for c in ("general", "glycine", "proline"))
     assert ramachandran_region(-63, -43, general) == FAVOURED  # α helix
