@@ -58,6 +58,7 @@ from app.editor.scene.overlay import Comparison, ComparisonView
 from app.editor.scene.scene import Layer, Scene
 from app.editor.scene.validation_markers import ValidationMarkers
 from app.editor.scripting import EditorAPI
+from core.geometry.validation import Flag
 from core.protein.structure import StructureError
 from core.protein.writing import atomic_write
 
@@ -107,6 +108,7 @@ class MainWindow(QMainWindow):
         self.comparison_view = ComparisonView(self.comparison, self.plotter)
         self.comparison_panel = ComparisonPanel(self.comparison)
         self.validation_panel = ValidationPanel(self.validation)
+        self.validation_panel.flagActivated.connect(self.show_flag)
         self.surface_layer = SurfaceLayer(self.document, self.plotter)  # after the scene, which clears the view on load
         self.surface_panel = SurfacePanel(self.surface_layer)
         self.history = QUndoView(self.document.undo_stack)
@@ -333,6 +335,16 @@ class MainWindow(QMainWindow):
         painter.drawImage(corner, view.scaled(self.plotter.size()))
         painter.end()
         return image
+
+    def show_flag(self, flag: Flag) -> None:
+        """Centre the view on ``flag``'s marker; where its residues lie in one backbone segment,
+        that segment becomes the edited one (the flag's residues stay in ``flag.residues``)."""
+        starts = [segment.residue_index[0] for segment in self.document.structure.segments]
+        segments = set(np.searchsorted(starts, flag.residues, side="right") - 1)
+        if len(segments) == 1:
+            self.document.set_segment(int(segments.pop()))  # frames the segment: centre afterwards
+        self.scene.centre_on(np.array(flag.position))
+        self.plotter.render()
 
     # ------------------------------------------------------------------ events
 

@@ -143,6 +143,15 @@ class Scene(QObject):
         low, high = ca.min(axis=0) - 2.0, ca.max(axis=0) + 2.0
         self.plotter.renderer.ResetCamera(low[0], high[0], low[1], high[1], low[2], high[2])
 
+    def centre_on(self, point: np.ndarray) -> None:
+        """Move the camera so that ``point`` (3,), Å, is in the middle of the view, looking
+        along the same direction from the same distance."""
+        camera = self.plotter.renderer.GetActiveCamera()
+        point = np.asarray(point, dtype=float)
+        camera.SetPosition(*(np.array(camera.GetPosition()) + point - camera.GetFocalPoint()))
+        camera.SetFocalPoint(*point)
+        self.plotter.renderer.ResetCameraClippingRange()
+
     def shown_control_points(self) -> np.ndarray:
         """Indices (into the level curve's control points) of the spheres on screen."""
         return self._shown_points
