@@ -8,6 +8,13 @@ than half of the residues is checked in full. Every atom outside a change is whe
 when the report described it, so the folded report is the report of the current
 coordinates. Views follow :attr:`LiveValidation.updated`.
 
+The first full check of a structure is also its :attr:`~LiveValidation.baseline` (the
+structure as read; a replayed session is checked as read once more): each flag of a later
+report is new, worse or as read against it, and :attr:`~LiveValidation.triaged` holds the
+flags that the :attr:`~LiveValidation.triage_filter` shows (by default those the session's
+edits made or worsened, and the severe ones: :mod:`core.geometry.triage`), sorted out after
+every check at the cost of a dictionary look-up per flag.
+
 During a drag the report is brought up to date from the event loop, at most every
 :data:`DRAG_INTERVAL_MS` (the residues moved meanwhile are checked together), so a drag
 step does not pay for a check; every other change, the end of a drag included, is
@@ -22,6 +29,7 @@ import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 
 from app.editor.document import Change, Document
+from core.geometry.triage import Baseline, Triaged, TriageFilter, triage
 from core.geometry.validation import ValidationReport, validate
 
 LOCAL_FRACTION = 0.5
@@ -36,11 +44,18 @@ class LiveValidation(QObject):
 
     updated = Signal()
     """:attr:`report` describes new coordinates (or a new structure)."""
+    triageChanged = Signal()
+    """:attr:`triage_filter` changed (and with it :attr:`triaged`)."""
 
     def __init__(self, document: Document) -> None:
         super().__init__(document)
         self.document = document
         self.report: ValidationReport | None = None
+        self.baseline: Baseline | None = None
+        """The flags of the structure as read."""
+        self.triage_filter = TriageFilter()
+        self.triaged: Triaged | None = None
+        """:attr:`report` sorted out against :attr:`baseline` by :attr:`triage_filter`."""
         self.elapsed_ms = 0.0
         """Time of the last check, ms (a full one after loading, a local one after a change)."""
         self.local = False
@@ -52,10 +67,10 @@ class LiveValidation(QObject):
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.timeout.connect(lambda: self._check_pending(late=True))
-        document.loaded.connect(self._check_all)
+        document.loaded.connect(self._load)
         document.changed.connect(self._check_change)
         if document.model is not None:
-            self._check_all()
+            self._load()
 
     @property
     def pending(self) -> bool:
@@ -66,11 +81,28 @@ class LiveValidation(QObject):
         """Run a check that waits for the drag interval at once (if there is one)."""
         self._check_pending()
 
+    def set_triage(self, triage_filter: TriageFilter) -> None:
+        """Show the flags that ``triage_filter`` lets through."""
+        if triage_filter == self.triage_filter:
+            return
+        self.triage_filter = triage_filter
+        if self.report is not None:
+            self.triaged = triage(self.report, self.baseline, triage_filter)
+        self.triageChanged.emit()
+
+    def _load(self) -> None:
+        self.baseline = None
+        self._check_all()
+
     def _check_all(self, late: bool = False) -> None:
         self._timer.stop()
         self._pending = None
         start = time.perf_counter()
-        self.report = validate(self.document.structure, self.document.model.coords)
+        structure, coords = self.document.structure, self.document.model.coords
+        self.report = validate(structure, coords)
+        if self.baseline is None:  # the first check of this structure
+            as_read = np.array_equal(coords, structure.coords)
+            self.baseline = Baseline.of(self.report if as_read else validate(structure))
         self._done(start, local=False, late=late)
 
     def _check_change(self, change: Change) -> None:
@@ -102,4 +134,5 @@ class LiveValidation(QObject):
         self.elapsed_ms = 1e3 * (self._finished - start)
         self.local = local
         self.late = late
+        self.triaged = triage(self.report, self.baseline, self.triage_filter)
         self.updated.emit()

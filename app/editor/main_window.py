@@ -64,6 +64,7 @@ from app.editor.scene.overlay import Comparison, ComparisonView
 from app.editor.scene.scene import Layer, Scene
 from app.editor.scene.validation_markers import ValidationMarkers
 from app.editor.scripting import EditorAPI
+from core.geometry.validation import Flag
 from core.protein.lookup import find_residues
 from core.protein.structure import StructureError
 from core.protein.writing import atomic_write
@@ -118,6 +119,7 @@ class MainWindow(QMainWindow):
         self.validation_panel = ValidationPanel(self.validation)
         self.ramachandran_panel = RamachandranPanel(self.document, self.validation)
         self.ramachandran_panel.residueActivated.connect(lambda row: self.select_and_centre([row]))
+        self.validation_panel.flagActivated.connect(self.show_flag)
         self.surface_layer = SurfaceLayer(self.document, self.plotter)  # after the scene, which clears the view on load
         self.surface_panel = SurfacePanel(self.surface_layer)
         self.history = QUndoView(self.document.undo_stack)
@@ -350,6 +352,16 @@ class MainWindow(QMainWindow):
         painter.drawImage(corner, view.scaled(self.plotter.size()))
         painter.end()
         return image
+
+    def show_flag(self, flag: Flag) -> None:
+        """Centre the view on ``flag``'s marker and select its residues; where they lie in one
+        backbone segment, that segment becomes the edited one."""
+        segments = {self.document.segment_of(row) for row in flag.residues}
+        if len(segments) == 1:
+            self.document.set_segment(segments.pop())  # frames the segment: centre afterwards
+        self.document.select(list(flag.residues))
+        self.scene.centre_on(np.array(flag.position))
+        self.plotter.render()
 
     # ------------------------------------------------------------------ events
 

@@ -1,2 +1,3 @@
-"""Stereochemistry of a model: validation (peptide junctions, Ramachandran, clashes) and the
-regularization that restores it after an edit."""
+"""Stereochemistry of a model: validation (peptide junctions, Ramachandran, clashes), the
+triage of its flags against the structure as read, and the regularization that restores it
+after an edit."""

@@ -185,13 +185,6 @@ class Scene(QObject):
         camera.SetPosition(*(np.array(camera.GetPosition()) + offset))
         self.plotter.renderer.ResetCameraClippingRange()
 
-    def frame_residues(self, rows: np.ndarray, margin: float = 8.0) -> None:
-        """Centre the view on residues ``rows`` (residue-table rows) and fit them, with
-        ``margin`` Å around, looking from where the camera is."""
-        ca = self.document.model.coords[self.document.ca_rows[np.asarray(rows)]]
-        low, high = ca.min(axis=0) - margin, ca.max(axis=0) + margin
-        self.plotter.renderer.ResetCamera(low[0], high[0], low[1], high[1], low[2], high[2])
-
     def shown_atoms(self) -> np.ndarray:
         """Rows of the coordinates of the atoms drawn now (polymer atoms, ligands, ions)."""
         rows = [rows for layer, rows in self._atom_rows.items() if layer in self.layers]

@@ -1,9 +1,10 @@
 """Markers on the model at the bad peptide junctions and the clashes, coloured by severity.
 
 One actor of its own (``validation_markers``, the scene's :attr:`~app.editor.scene.scene.Layer.VALIDATION`
-layer): a point set drawn as spheres, one point per junction or clash flag of the live
-report, rewritten in place when the report changes. Ramachandran outliers are listed in the
-validation panel but not marked (a residue, not a place between atoms).
+layer): a point set drawn as spheres, one point per junction or clash flag that the live
+report's triage filter shows (:attr:`~app.editor.live_validation.LiveValidation.triaged`),
+rewritten in place when the report or the filter changes. Ramachandran outliers are listed
+in the validation panel but not marked (a residue, not a place between atoms).
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ def marked(flags: tuple[Flag, ...]) -> tuple[np.ndarray, np.ndarray]:
 
 
 class ValidationMarkers(QObject):
-    """Draws the live report's junction and clash flags into the scene's plotter."""
+    """Draws the junction and clash flags shown of the live report into the scene's plotter."""
 
     def __init__(self, validation: LiveValidation, scene: Scene) -> None:
         super().__init__(scene)
@@ -49,14 +50,15 @@ class ValidationMarkers(QObject):
         self.scene = scene
         self.mesh = pv.PolyData()
         validation.updated.connect(self.refresh)
+        validation.triageChanged.connect(lambda: self.refresh(render=True))
         scene.document.loaded.connect(self.refresh)  # after the scene's rebuild, which removes every actor
         self.refresh()
 
-    def refresh(self) -> None:
-        """Show the markers of the current report; render only after a deferred check (the
-        scene renders after each change)."""
-        report = self.validation.report
-        if report is None:
+    def refresh(self, render: bool = False) -> None:
+        """Show the markers of the flags shown; render after a deferred check or with ``render``
+        (the scene renders after each change)."""
+        triaged = self.validation.triaged
+        if triaged is None:
             return
         if NAME not in self.scene.plotter.actors:
             self.mesh.shallow_copy(_points(np.zeros((1, 3)), np.zeros((1, 3), dtype=np.uint8)))  # not empty
@@ -64,7 +66,7 @@ class ValidationMarkers(QObject):
                 self.mesh, name=NAME, scalars="colours", rgb=True, render_points_as_spheres=True,
                 point_size=MARKER_PIXELS, reset_camera=False, pickable=False, show_scalar_bar=False, render=False,
             )
-        positions, severity = marked(report.flags)
+        positions, severity = marked(triaged.flags)
         colours = severity_colours(severity)
         if len(positions) and len(positions) == self.mesh.n_points:
             for target, values in ((self.mesh.GetPoints().GetData(), positions),
@@ -76,7 +78,7 @@ class ValidationMarkers(QObject):
             self.mesh.shallow_copy(_points(positions, colours))
         visible = Layer.VALIDATION in self.scene.layers
         self.scene.actors[NAME].SetVisibility(visible)
-        if visible and self.validation.late:
+        if visible and (self.validation.late or render):
             self.scene.plotter.render()
 
 

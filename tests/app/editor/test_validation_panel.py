@@ -12,10 +12,12 @@ from pytestqt.qtbot import QtBot
 from test_window import _display, _mouse_drag, _window
 
 from app.editor import document as document_module, live_validation
+from app.editor.docks.validation import CHECKED_NAMES, LISTED
 from app.editor.main_window import MainWindow
 from app.editor.scene.scene import Layer
 from app.editor.scene.validation_markers import MARKED, severity_colours
 from core.geometry.topology import topology
+from core.geometry.triage import Baseline, Triaged, triage
 from core.geometry.validation import validate
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -49,16 +51,33 @@ def _marked_flags(window: MainWindow) -> list:
     return [f for f in validate(window.document.structure, window.document.model.coords).flags if f.kind in MARKED]
 
 
+def _triaged(window: MainWindow) -> Triaged:
+    """The model's flags that the default filter shows against the file, computed afresh."""
+    structure = window.document.structure
+    return triage(validate(structure, window.document.model.coords), Baseline.of(validate(structure)))
+
+
+def _shown_marked(window: MainWindow) -> list:
+    """The flags that should have a marker: of the marked kinds, shown by the default filter."""
+    return [f for f in _triaged(window).flags if f.kind in MARKED]
+
+
 def _assert_panel_matches_the_model(window: MainWindow) -> None:
     full = validate(window.document.structure, window.document.model.coords)
     report = window.validation.report
     assert report.counts == full.counts
     assert sorted((f.kind, f.where) for f in report.flags) == sorted((f.kind, f.where) for f in full.flags)
-    for kind, label in window.validation_panel.count_labels.items():
-        assert label.text().startswith(f"{full.counts[kind]} of {full.checked[kind]} ")
-    assert window.validation_panel.worst.topLevelItemCount() == min(15, len(full.flags))
-    if full.flags:
-        assert window.validation_panel.worst.topLevelItem(0).text(1) == full.flags[0].where
+    expected, panel = _triaged(window), window.validation_panel
+    for kind, label in panel.count_labels.items():
+        changes = [f"{n} {what}" for n, what in ((expected.new[kind], "new"), (expected.worse[kind], "worse")) if n]
+        total = f"{full.counts[kind]} of {full.checked[kind]} {CHECKED_NAMES.get(kind, 'junctions')}"
+        assert label.text() == ", ".join(changes + [total])
+    triaged, shown = window.validation.triaged, len(expected.flags)
+    assert sorted((f.kind, f.where) for f in triaged.flags) == sorted((f.kind, f.where) for f in expected.flags)
+    assert panel.listed == triaged.flags[:LISTED]
+    assert panel.offenders.topLevelItemCount() == min(LISTED, shown) + (shown > LISTED)
+    if shown:
+        assert panel.offenders.topLevelItem(0).text(2) == expected.flags[0].where
 
 
 def test_a_drag_is_regularized_on_release_in_one_undo_step(window: MainWindow) -> None:
@@ -162,14 +181,16 @@ def test_markers_show_a_bad_edit_until_the_region_is_regularized(window: MainWin
     document, mesh = window.document, window.markers.mesh
     assert not window.regularize_action.isEnabled()  # nothing picked
     before = _marked_flags(window)
-    assert mesh.n_points == len(before)
+    assert mesh.n_points == len(_shown_marked(window)) == 0  # the file's one clash is mild
     window.validation_panel.on_release.setChecked(False)
     _mouse_drag(window, _press_point(window), OFFSET)
     bad = _marked_flags(window)
     assert len(bad) > len(before) + 10
     assert {f.kind for f in bad} >= {"peptide_bond", "clash"}
-    np.testing.assert_allclose(mesh.points, [f.position for f in bad], atol=1e-4)
-    np.testing.assert_array_equal(mesh.point_data["colours"], severity_colours([f.severity for f in bad]))
+    shown = _shown_marked(window)
+    assert len(shown) >= len(bad) - len(before)  # everything the edit made
+    np.testing.assert_allclose(mesh.points, [f.position for f in shown], atol=1e-4)
+    np.testing.assert_array_equal(mesh.point_data["colours"], severity_colours([f.severity for f in shown]))
     assert window.plotter.actors["validation_markers"].GetVisibility()
 
     edited = document.model.coords.copy()
@@ -179,9 +200,9 @@ def test_markers_show_a_bad_edit_until_the_region_is_regularized(window: MainWin
     after = _marked_flags(window)
     assert not any(f.kind != "clash" for f in after)  # every junction is ideal again
     assert {f.where for f in after} <= {f.where for f in before}  # at most the clash of the file is left
-    assert mesh.n_points == len(after)
+    assert mesh.n_points == len(_shown_marked(window))
     window.undo_action.trigger()
-    assert np.array_equal(document.model.coords, edited) and mesh.n_points == len(bad)
+    assert np.array_equal(document.model.coords, edited) and mesh.n_points == len(shown)
 
 
 def test_the_layer_toggle_hides_the_markers(window: MainWindow) -> None:
@@ -192,12 +213,13 @@ def test_the_layer_toggle_hides_the_markers(window: MainWindow) -> None:
     actor = window.plotter.actors["validation_markers"]
     assert not actor.GetVisibility()
     _mouse_drag(window, _press_point(window), OFFSET)
-    assert not actor.GetVisibility() and window.markers.mesh.n_points == len(_marked_flags(window))  # kept up to date
+    assert not actor.GetVisibility() and window.markers.mesh.n_points == len(_shown_marked(window))  # kept up to date
+    assert window.markers.mesh.n_points > 10
     box.setChecked(True)
     assert actor.GetVisibility()
     assert window.open_file(DATA / "1TIM.pdb.gz")  # the scene's rebuild keeps the markers
     assert window.plotter.actors["validation_markers"].GetVisibility()
-    assert window.markers.mesh.n_points == len(_marked_flags(window))
+    assert window.markers.mesh.n_points == len(_shown_marked(window))
 
 
 def test_severity_colours_run_from_yellow_to_red() -> None:
