@@ -127,24 +127,25 @@ class MainWindow(QMainWindow):
         self.rw = EditorAPI(self)
         """The ``rw`` object of scripts and of the Python console."""
         self.console = PythonConsole({"rw": self.rw, "np": np})
-        docks = [self._dock("Ribbon dimension", _scrolled(self.dimension_panel)),
-                 self._dock("Display", _scrolled(self.display_panel)),
-                 self._dock("Undo history", self.history), self._dock("Validation", _scrolled(self.validation_panel)),
-                 self._dock("Compared structures", self.comparison_panel)]
-        docks.append(self._dock("Surface", self.surface_panel))
         self.sequence_bar = SequenceBar(self.document)
         self.sequence_bar.strip.residuesActivated.connect(self.select_and_centre)
-        docks.append(self._dock("Sequence", self.sequence_bar, Qt.DockWidgetArea.TopDockWidgetArea))
+        # the right column runs from the toolbar to the status bar; the sequence bar spans the view only
+        self.setCorner(Qt.Corner.TopRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
+        self.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
+        dimension = self._dock("Ribbon dimension", _scrolled(self.dimension_panel))
+        tabs = [self._dock("Display", _scrolled(self.display_panel)), self._dock("Surface", self.surface_panel),
+                self._dock("Validation", _scrolled(self.validation_panel)),
+                self._dock("Ramachandran", _scrolled(self.ramachandran_panel)),
+                self._dock("Compare", self.comparison_panel), self._dock("History", self.history)]
+        for dock in tabs[1:]:  # one group of tabs under the level controls: each gets the column's height
+            self.tabifyDockWidget(tabs[0], dock)
+        tabs[0].raise_()
+        docks = [dimension, *tabs, self._dock("Sequence", self.sequence_bar, Qt.DockWidgetArea.TopDockWidgetArea)]
         self.console_dock = self._dock("Python Console", self.console, Qt.DockWidgetArea.BottomDockWidgetArea)
         self.console_dock.hide()
-        self.tabifyDockWidget(docks[1], docks[5])  # the surface beside the ribbon's display options
-        docks[1].raise_()
-        self.tabifyDockWidget(docks[2], docks[3])  # validation and history share a place: the window stays small
-        self.tabifyDockWidget(docks[2], docks[4])  # and the compared structures
-        docks.append(self._dock("Ramachandran", _scrolled(self.ramachandran_panel)))
-        self.tabifyDockWidget(docks[3], docks[-1])  # beside the validation
-        docks[3].raise_()
-        self.console_dock.visibilityChanged.connect(self._hide_stale_tab_bars)
+        self.resizeDocks([dimension], [self.dimension_panel.sizeHint().height() + 30], Qt.Orientation.Vertical)
+        self._tidy_tab_bars()
+        self.console_dock.visibilityChanged.connect(self._tidy_tab_bars)
         self._create_actions()
         self._create_menus(docks)
         self._create_status_bar()
@@ -508,15 +509,18 @@ class MainWindow(QMainWindow):
             self.resize(_fitted(self.size()))
         if layout is not None:
             self.restoreState(layout)
-            self._hide_stale_tab_bars()
+            self._tidy_tab_bars()
 
-    def _hide_stale_tab_bars(self) -> None:
-        """Qt (6.11) leaves the tab bar of a two-dock group visible, under the docks, once a third
-        dock joins the group; a bottom dock uncovers it. Hide every tab bar whose tabs another
+    def _tidy_tab_bars(self) -> None:
+        """Dock tabs show their whole titles (scroll buttons when they do not fit). Qt (6.11)
+        also leaves the tab bar of a two-dock group visible, under the docks, once a third
+        dock joins the group; a bottom dock uncovers it: hide every tab bar whose tabs another
         one shows too."""
         bars = [bar for bar in self.findChildren(QTabBar) if bar.parent() is self]
         tabs = {bar: {bar.tabText(k) for k in range(bar.count())} for bar in bars}
         for bar in bars:
+            bar.setElideMode(Qt.TextElideMode.ElideNone)
+            bar.setUsesScrollButtons(True)
             if any(other is not bar and tabs[bar] < tabs[other] for other in bars):
                 bar.hide()
 

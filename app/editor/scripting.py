@@ -61,6 +61,19 @@ class EditorAPI:
         """(n_atoms, 3) every atom of the edited structure, Å."""
         return self._document.model.coords.copy()
 
+    @property
+    def selection(self) -> list[str]:
+        """Labels of the selected residues, e.g. ``['A:LYS48']``."""
+        document = self._document
+        return [document.row_label(int(row)) for row in document.selection]
+
+    def go_to(self, residues: str) -> list[str]:
+        """Select ``residues`` (``'A:45'``, ``'45'`` in the edited chain, ``'A:40-50'``) and centre
+        the view on them, as Go to Residue (Ctrl+L) does; their chain becomes the edited
+        segment. Returns their labels (ValueError for a residue that does not exist)."""
+        document = self._document
+        return [document.row_label(int(row)) for row in self._window.go_to(residues)]
+
     def history(self) -> tuple[list[str], int]:
         """The names of the undo steps and the current position (steps done)."""
         stack = self._document.undo_stack

@@ -16,6 +16,7 @@ from PySide6.QtWidgets import (
     QComboBox,
     QDoubleSpinBox,
     QFormLayout,
+    QGridLayout,
     QGroupBox,
     QHBoxLayout,
     QLabel,
@@ -177,13 +178,13 @@ class DisplayPanel(QWidget):
         super().__init__(parent)
         self.scene = scene
         layers = QGroupBox("Layers")
-        layer_box = QVBoxLayout(layers)
+        layer_box = QGridLayout(layers)  # two columns: the dock fits a laptop's height
         self.layer_boxes: dict[Layer, QCheckBox] = {}
-        for layer in Layer:
+        for k, layer in enumerate(Layer):
             box = QCheckBox(layer.value[0].upper() + layer.value[1:])
             box.setChecked(layer in scene.layers)
             box.toggled.connect(lambda on, layer=layer: scene.set_layer(layer, on))
-            layer_box.addWidget(box)
+            layer_box.addWidget(box, k // 2, k % 2)
             self.layer_boxes[layer] = box
         self.colouring = QComboBox()
         for colouring in Colouring:

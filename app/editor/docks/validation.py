@@ -50,7 +50,7 @@ SEVERITIES = {"all flagged": 0.0, "severity > 2": 2.0, "severity > 4": 4.0}
 LISTED = 200
 """Rows of the list at most (a last row says how many more are shown on the model)."""
 COLUMNS = ("Severity", "Status", "Where", "Problem")
-LIST_LINES = 8
+LIST_LINES = 6
 """Height of the list at its smallest, in lines of text: it fits a 1366 × 768 screen's dock."""
 
 
@@ -124,17 +124,16 @@ class ValidationPanel(QWidget):
         self.while_dragging.setToolTip("Regularize every step of a drag (slower: tens of ms a step)")
         self.on_release.setChecked(document.regularize_on_release)
         self.while_dragging.setChecked(document.regularize_while_dragging)
-        switches = QGroupBox("Regularization")
-        switch_box = QHBoxLayout(switches)
-        switch_box.addWidget(self.on_release)
-        switch_box.addWidget(self.while_dragging)
+        switches = QHBoxLayout()
+        switches.addWidget(self.on_release)
+        switches.addWidget(self.while_dragging)
 
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(filters)
         layout.addWidget(self.offenders, 1)
         layout.addWidget(counts)
-        layout.addWidget(switches)
+        layout.addLayout(switches)
         self.scope.currentIndexChanged.connect(
             lambda: validation.set_triage(replace(validation.triage_filter, scope=self.scope.currentData())))
         self.severity.currentIndexChanged.connect(

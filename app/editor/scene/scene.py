@@ -30,7 +30,7 @@ FAT_RADII = {"H": 1.5, "E": 1.8, "C": 0.45}
 CA_RADIUS = 0.45
 LIGAND_ATOM_RADIUS = 0.35
 ION_RADIUS = 1.1
-POINT_SPACING_FRACTION = 0.12
+POINT_SPACING_FRACTION = 0.08
 """Control-point spheres have this fraction of the level's median control-point spacing as
 radius (at least HANDLE_RADIUS)..."""
 MIN_POINT_PIXELS = 6.0

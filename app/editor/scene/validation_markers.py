@@ -21,7 +21,7 @@ from core.geometry.validation import Flag
 NAME = "validation_markers"
 MARKED = ("peptide_bond", "ca_ca", "angle_ca_c_n", "angle_c_n_ca", "omega", "clash")
 """Flag kinds that get a marker."""
-MARKER_PIXELS = 14.0
+MARKER_PIXELS = 10.0
 """Marker diameter on screen, pixels."""
 MILD, SEVERE = np.array([250, 205, 40]), np.array([215, 25, 28])
 """Colours of a flag just over its tolerance (severity 1) and of one at :data:`SEVERE_AT` or more."""

@@ -306,3 +306,21 @@ def test_other_chains_dimmed_hidden_and_shown(qtbot: QtBot) -> None:
 def test_small_entries_open_with_every_chain_shown(qtbot: QtBot) -> None:
     window = _window(qtbot, "4HHB.pdb.gz")
     assert window.scene.others is Others.SHOWN
+
+
+def test_the_docks_fit_a_laptop_screen_without_scrolling(qtbot: QtBot) -> None:
+    """1366 x 768 (less a panel): the level controls, the display options, the validation list
+    and the Ramachandran plot each show whole in their place."""
+    from PySide6.QtWidgets import QDockWidget, QScrollArea
+
+    window = _window(qtbot, "4HHB.pdb.gz")
+    window.resize(1366, 728)
+    qtbot.wait(50)
+    docks = {dock.windowTitle(): dock for dock in window.findChildren(QDockWidget)}
+    for title in ("Ribbon dimension", "Display", "Validation", "Ramachandran"):
+        docks[title].raise_()
+        qtbot.wait(20)
+        area = docks[title].widget()
+        assert isinstance(area, QScrollArea)
+        assert not area.verticalScrollBar().isVisible(), title
+    assert window.plotter.width() >= 800 and window.plotter.height() >= 450

@@ -131,3 +131,17 @@ def test_the_python_console_drives_the_editor(qtbot: QtBot) -> None:
     qtbot.keyClick(window.console.input, Qt.Key.Key_Return)
     assert window.document.level == 2.5 and window.document.undo_stack.count() == 1
     assert "Move point 3 at level 2.50" in window.console.output.toPlainText()
+
+
+def test_go_to_is_what_the_go_to_field_does(qtbot: QtBot) -> None:
+    window = _window(qtbot, DATA / "4HHB.pdb.gz")
+    rw = window.rw
+    assert rw.go_to("B:40-42") == rw.selection == ["B:ARG40", "B:PHE41", "B:PHE42"]
+    assert window.document.structure.segments[rw.segment].chain == "B"
+    typed = _window(qtbot, DATA / "4HHB.pdb.gz")
+    typed.go_to_field.setText("B:40-42")
+    typed.go_to_field.returnPressed.emit()  # as Enter in the field
+    assert typed.rw.selection == rw.selection and typed.rw.segment == rw.segment
+    assert np.allclose(typed.plotter.camera.focal_point, window.plotter.camera.focal_point)
+    with pytest.raises(ValueError, match="no residue B:400"):
+        rw.go_to("B:400")
