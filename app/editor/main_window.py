@@ -1,7 +1,7 @@
 """The editor's main window: the 3D view, the docks, menus, toolbar and status bar.
 
 The window wires the pieces together: a :class:`~app.editor.document.Document`, the
-:class:`~app.editor.scene.scene.Scene` drawing it into a pyvistaqt ``QtInteractor``, the
+:class:`~app.editor.scene.scene.Scene` drawing it into the :class:`~app.editor.scene.view.View`, the
 :class:`~app.editor.picking.PointerAdapter` feeding mouse events to the
 :class:`~app.editor.drag.DragController`, and the dock panels. It also owns the file dialogs
 (open, save, recent files, drag-and-drop, image export) and asks before unsaved edits
@@ -43,7 +43,6 @@ from PySide6.QtWidgets import (
     QUndoView,
     QWidget,
 )
-from pyvistaqt import QtInteractor
 
 from app import EXAMPLES_DIR
 from app.editor.docks.comparison import ComparisonPanel
@@ -63,6 +62,7 @@ from app.editor.scene.molecule import Colouring
 from app.editor.scene.overlay import Comparison, ComparisonView
 from app.editor.scene.scene import Layer, Scene
 from app.editor.scene.validation_markers import ValidationMarkers
+from app.editor.scene.view import View
 from app.editor.scripting import EditorAPI
 from core.geometry.validation import Flag
 from core.protein.lookup import find_residues
@@ -96,7 +96,7 @@ class MainWindow(QMainWindow):
         """Run by a script: no dialog waits for a person, and unsaved edits stay in the journal."""
         self.journal = journal.Journal(self.document)
 
-        self.plotter = QtInteractor(self, auto_update=False)
+        self.plotter = View(self, auto_update=False)
         self.plotter.setAcceptDrops(False)  # dropped files go to the window, which opens them
         self.plotter.iren.clear_key_event_callbacks()  # no pyvista key bindings ('q' would close the view)
         self._swallow_style_keys()

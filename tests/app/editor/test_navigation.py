@@ -50,6 +50,13 @@ def _widget_point(window: MainWindow, point: np.ndarray) -> QPoint:
     return QPoint(round(x / scale), round(window.plotter.height() - 1 - y / scale))
 
 
+def _drawn(qtbot: QtBot, window: MainWindow) -> None:
+    """Ask for a frame and wait until it is drawn (the view draws when the event loop turns)."""
+    frames = window.plotter.frames
+    window.plotter.render()
+    qtbot.waitUntil(lambda: window.plotter.frames > frames)
+
+
 def _ca(window: MainWindow, row: int) -> np.ndarray:
     return window.document.model.coords[window.document.ca_rows[row]]
 
@@ -228,7 +235,7 @@ def test_control_points_keep_a_size_on_screen(qtbot: QtBot) -> None:
 
     assert scene.point_radius > HANDLE_RADIUS and pixels() >= MIN_POINT_PIXELS * 0.95
     camera.zoom(0.3)
-    window.plotter.render()
+    _drawn(qtbot, window)  # the spheres are sized as a frame is drawn
     assert pixels() >= MIN_POINT_PIXELS * 0.95
     sphere = window.scene.meshes["control_points"].points[:42]
     assert np.linalg.norm(sphere - sphere.mean(axis=0), axis=1).max() == pytest.approx(scene.point_radius)

@@ -1,0 +1,145 @@
+"""End to end: a real Qt event sent to a real editor window, timed until its frame is drawn.
+
+Usage: ``xvfb-run -a python benchmarks/bench_interaction.py [--steps N] [STRUCTURE ...]``
+(default: 1UBQ, 1AYE, 4YVS from tests/data). Each event goes through Qt as the mouse or the
+keyboard sends it (QTest), and the clock stops once the event loop has nothing left to do,
+the render included; a counter on the render window says how many frames each event drew.
+
+Events: a level-slider step (the Right key on the slider), a pick (a click on a control
+point), a drag step (a mouse move while a control point is held), a release (regularized,
+as by default), a camera rotation step (a mouse move while the left button turns the view)
+and a zoom step (one wheel notch). Medians and 90th percentiles in ms.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from PySide6.QtCore import QPoint, QPointF, QSettings, Qt
+from PySide6.QtGui import QWheelEvent
+from PySide6.QtTest import QTest
+from PySide6.QtWidgets import QApplication
+
+from app.editor.document import Document
+from app.editor.main_window import MainWindow
+
+DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
+DEFAULT = ("1UBQ.pdb.gz", "1AYE.pdb.gz", "4YVS.cif.gz")
+
+
+class Frames:
+    """Counts the frames the render window draws."""
+
+    def __init__(self, window: MainWindow) -> None:
+        self.count = 0
+        window.plotter.ren_win.AddObserver("EndEvent", lambda *_: self._drawn())
+
+    def _drawn(self) -> None:
+        self.count += 1
+
+
+def _settle(app: QApplication) -> None:
+    """Run the event loop until nothing is left (deferred renders and checks included)."""
+    for _ in range(3):
+        app.processEvents()
+
+
+def _widget_point(window: MainWindow, point: np.ndarray) -> QPoint:
+    renderer = window.plotter.renderer
+    renderer.SetWorldPoint(*point, 1.0)
+    renderer.WorldToDisplay()
+    x, y, _ = renderer.GetDisplayPoint()
+    scale = window.plotter.devicePixelRatioF()
+    return QPoint(round(x / scale), round(window.plotter.height() - 1 - y / scale))
+
+
+def _timed(app: QApplication, frames: Frames, send) -> tuple[float, int]:  # noqa: ANN001 (a callable)
+    before = frames.count
+    start = time.perf_counter()
+    send()
+    _settle(app)
+    return 1e3 * (time.perf_counter() - start), frames.count - before
+
+
+def measure(app: QApplication, path: Path, steps: int) -> dict[str, tuple[list[float], list[int]]]:
+    """Times and frame counts of every kind of event on the structure at ``path``."""
+    document = Document()
+    document.open(path)
+    window = MainWindow(document)
+    window.resize(1400, 900)
+    window.show()
+    QTest.qWaitForWindowExposed(window)
+    _settle(app)
+    frames = Frames(window)
+    view = window.plotter
+    results: dict[str, tuple[list[float], list[int]]] = {}
+
+    def record(kind: str, sample: tuple[float, int]) -> None:
+        results.setdefault(kind, ([], []))
+        results[kind][0].append(sample[0])
+        results[kind][1].append(sample[1])
+
+    slider = window.dimension_panel.slider
+    slider.setFocus()
+    for k in range(steps):
+        key = Qt.Key.Key_Right if k % 2 == 0 else Qt.Key.Key_Left
+        record("slider step", _timed(app, frames, lambda key=key: QTest.keyClick(slider, key)))
+
+    for k in range(steps):
+        shown = window.scene.shown_control_points()
+        index = int(shown[(3 + k) % len(shown)])
+        at = _widget_point(window, document.level_curve().control_points[index])
+        record("pick", _timed(app, frames, lambda at=at: (QTest.mousePress(view, Qt.MouseButton.LeftButton, pos=at),
+                                                           QTest.mouseRelease(view, Qt.MouseButton.LeftButton, pos=at))))
+        QTest.mousePress(view, Qt.MouseButton.LeftButton, pos=at)
+        for m in range(1, 6):
+            record("drag step", _timed(app, frames, lambda m=m, at=at: QTest.mouseMove(view, at + QPoint(4 * m, 3 * m))))
+        record("release", _timed(app, frames, lambda at=at: QTest.mouseRelease(
+            view, Qt.MouseButton.LeftButton, pos=at + QPoint(20, 15))))
+        document.undo_stack.undo()
+        _settle(app)
+
+    corner = QPoint(12, view.height() - 12)  # nothing there: the press turns the camera
+    QTest.mousePress(view, Qt.MouseButton.LeftButton, pos=corner)
+    for m in range(1, steps + 1):
+        record("rotate step", _timed(app, frames, lambda m=m: QTest.mouseMove(view, corner + QPoint(3 * m, -2 * m))))
+    QTest.mouseRelease(view, Qt.MouseButton.LeftButton, pos=corner + QPoint(3 * steps, -2 * steps))
+    _settle(app)
+
+    centre = QPointF(view.width() / 2, view.height() / 2)
+    for m in range(steps):
+        delta = 120 if m % 2 == 0 else -120
+
+        def wheel(delta: int = delta) -> None:
+            event = QWheelEvent(centre, view.mapToGlobal(centre), QPoint(), QPoint(0, delta), Qt.MouseButton.NoButton,
+                                Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase, False)
+            QApplication.sendEvent(view, event)
+
+        record("zoom step", _timed(app, frames, wheel))
+    window.quit_unattended(discard=True)
+    _settle(app)
+    return results
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("structures", nargs="*", default=list(DEFAULT))
+    parser.add_argument("--steps", type=int, default=20)
+    args = parser.parse_args()
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    QSettings.setPath(QSettings.Format.NativeFormat, QSettings.Scope.UserScope, tempfile.mkdtemp())  # not the user's
+    print(f"{'structure':<12} {'event':<12} {'median ms':>10} {'p90 ms':>8} {'frames/event':>13}")
+    for name in args.structures:
+        path = Path(name) if Path(name).exists() else DATA / name
+        for kind, (times, counts) in measure(app, path, args.steps).items():
+            print(f"{path.name.split('.')[0]:<12} {kind:<12} {np.median(times):>10.1f} {np.percentile(times, 90):>8.1f} "
+                  f"{np.mean(counts):>13.2f}")
+
+
+if __name__ == "__main__":
+    main()
