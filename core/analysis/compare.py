@@ -104,14 +104,36 @@ def pair_residues(
 
     ``'numbering'`` pairs equal residue numbers and insertion codes; ``'alignment'`` aligns
     the residue-name sequences (:func:`core.analysis.superpose.align_sequences`); ``'structure'``
-    refines that alignment by where the Cα lie (:func:`core.analysis.fold_alignment.align_structures`),
-    which homologues need. ``'auto'`` uses the numbering when the residues it pairs carry
-    the same names and cover at least half of the shorter chain, the sequence alignment when
-    it finds the same protein (:data:`SAME_PROTEIN`), and the structural alignment otherwise.
+    pairs the residues by where the Cα lie (:func:`core.analysis.fold_alignment.align_structures`,
+    started also from the sequence alignment), which homologues need. ``'auto'`` decides as
+    :func:`pair_by_sequence` does.
 
     Returns
     -------
     (indices into chain a, indices into chain b, the pairing used)
+    """
+    pairs_a, pairs_b, pairing = pair_by_sequence(chain_a, chain_b, pairing)
+    if pairing != "structure":
+        return pairs_a, pairs_b, pairing
+    ca_a, ca_b = (np.concatenate([s.ca for s in chain]) for chain in (chain_a, chain_b))
+    start = (pairs_a, pairs_b) if len(pairs_a) >= MIN_PAIRS else (None, None)
+    return *align_structures(ca_a, ca_b, *start), "structure"
+
+
+def pair_by_sequence(
+    chain_a: Sequence[BackboneSegment], chain_b: Sequence[BackboneSegment], pairing: str = "auto"
+) -> tuple[np.ndarray, np.ndarray, str]:
+    """The pairing of :func:`pair_residues` as far as the sequences decide it.
+
+    ``'auto'`` uses the numbering when the residues it pairs carry the same names and cover
+    at least half of the shorter chain, the sequence alignment when it finds the same
+    protein (:data:`SAME_PROTEIN`), and otherwise says ``'structure'``: the chains are of
+    different proteins and the pairs returned, the sequence alignment's, only a start for
+    the structural alignment (as for ``pairing='structure'``).
+
+    Returns
+    -------
+    (indices into chain a, indices into chain b, 'numbering', 'alignment' or 'structure')
     """
     if pairing not in PAIRINGS:
         raise ValueError(f"pairing must be one of {', '.join(map(repr, PAIRINGS))}; got {pairing!r}")
@@ -125,10 +147,8 @@ def pair_residues(
         return pairs_a, pairs_b, "numbering"
     pairs_a, pairs_b = align_sequences(names_a.tolist(), names_b.tolist())
     identity = np.count_nonzero(names_a[pairs_a] == names_b[pairs_b]) / min(len(names_a), len(names_b))
-    if pairing == "alignment" or (pairing == "auto" and identity >= SAME_PROTEIN) or len(pairs_a) < MIN_PAIRS:
+    if pairing == "alignment" or (pairing == "auto" and identity >= SAME_PROTEIN):
         return pairs_a, pairs_b, "alignment"
-    ca_a, ca_b = (np.concatenate([s.ca for s in chain]) for chain in (chain_a, chain_b))
-    pairs_a, pairs_b = align_structures(ca_a, ca_b, pairs_a, pairs_b)
     return pairs_a, pairs_b, "structure"
 
 

@@ -1,11 +1,16 @@
 """Structures shown for comparison: superposed on the edited chain, drawn at the same depth.
 
 Each compared structure is read once; one of its chains (the longest unless chosen) is
-paired with the document's current chain by :func:`core.analysis.compare.pair_residues` and
-superposed on the paired Cα with :func:`core.analysis.superpose.superpose`, refined on the pairs
-within :data:`CORE_CUTOFF` (a few loops that differ between homologues would pull a fit
-on all pairs). Its ribbons are built in the document's ribbon kind and moved by that
-motion (a B-spline curve moves with its control points).
+paired with the document's current chain and superposed on it (:func:`fit_chain`). A chain
+of the same protein is paired by numbering or by sequence
+(:func:`core.analysis.compare.pair_by_sequence`) and superposed on the paired Cα, refined
+on the pairs within :data:`CORE_CUTOFF` (a few loops that moved would pull a fit on all
+pairs). A chain of another protein is aligned by structure and given the superposition
+that maximises its TM-score (:func:`core.analysis.fold_alignment.align_folds`, as
+TM-align does). Either way the fit reports the TM-score of that superposition, normalised
+by the edited chain's length: below 0.5 the folds differ, and an rms on the few pairs that
+happen to lie close says nothing. Its ribbons are built in the document's ribbon kind and
+moved by that motion (a B-spline curve moves with its control points).
 
 Levels: every chain has its own top level log2 N, so the compared chains are shown at the
 same *depth* below their top as the edited segment, ``log2 N_k - (log2 N - λ)``, and so
@@ -30,14 +35,18 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 from app.editor.document import Document
 from app.editor.scene import tube
 from app.editor.scene.curves import LevelCurve, SegmentPath
-from core.analysis.compare import pair_residues
+from core.analysis.compare import pair_by_sequence, tm_score
+from core.analysis.fold_alignment import align_folds, tm_d8
 from core.analysis.superpose import MIN_PAIRS, Superposition, fit_closest
 from core.protein.reading import read_bytes, read_structure
 from core.protein.ribbon import Ribbon, segment_ribbon
 from core.protein.structure import BackboneSegment, Structure
 
 CORE_CUTOFF = 3.0
-"""Å: the fit is refined on the paired Cα closer than this after fitting on themselves."""
+"""Å: the fit of a chain of the same protein is refined on the paired Cα closer than this
+after fitting on themselves."""
+SAME_FOLD = 0.5
+"""TM-score from which two chains have the same fold (Xu & Zhang 2010: below it, mostly not)."""
 PALETTE: tuple[tuple[int, int, int], ...] = (
     (31, 119, 180), (44, 160, 44), (0, 128, 128), (227, 119, 194), (200, 80, 0),
     (170, 0, 120), (60, 60, 160), (188, 189, 34), (150, 70, 40),
@@ -52,23 +61,35 @@ TUBE_SIDES = 8
 
 @dataclass(frozen=True)
 class ChainFit:
-    """A superposition of a compared chain on the edited chain.
+    """A superposition of a compared chain on the edited chain, and how well the two agree.
 
     Attributes
     ----------
     motion : moves the compared chain onto the edited one.
-    n_pairs : paired residues (by numbering or structural alignment) with both Cα.
-    n_core : pairs the refined fit was computed on (closer than :data:`CORE_CUTOFF`).
-    rms_core, rms_all : rms Cα distance (Å) over those and over all pairs after the fit.
-    pairing : 'numbering' or 'structure' (see :func:`core.analysis.compare.pair_residues`).
+    pairing : 'numbering' or 'alignment' (the same protein, paired by sequence) or
+        'structure' (another protein, aligned by structure); see :func:`fit_chain`.
+    length : residues of the edited chain, by which the TM-score is normalised.
+    n_pairs : residue pairs (with both Cα).
+    cutoff : Å, TM-align's cutoff of the aligned pairs (:func:`~core.analysis.fold_alignment.tm_d8`
+        of the shorter chain).
+    n_aligned : pairs closer than ``cutoff`` after the motion.
+    rms_aligned : rms Cα distance over those pairs after the motion, Å.
+    tm_score : TM-score of the pairs after the motion (TM-align's d0 for ``length``).
     """
 
     motion: Superposition
-    n_pairs: int
-    n_core: int
-    rms_core: float
-    rms_all: float
     pairing: str
+    length: int
+    n_pairs: int
+    cutoff: float
+    n_aligned: int
+    rms_aligned: float
+    tm_score: float
+
+    @property
+    def same_fold(self) -> bool:
+        """Whether the TM-score says the folds are the same (at least :data:`SAME_FOLD`)."""
+        return self.tm_score >= SAME_FOLD
 
 
 def chain_segments(structure: Structure, chain: str) -> list[BackboneSegment]:
@@ -90,6 +111,11 @@ def chains(structure: Structure) -> list[str]:
 def fit_chain(fixed_ca: np.ndarray, fixed: Sequence[BackboneSegment], moving: Sequence[BackboneSegment]) -> ChainFit:
     """Superpose the chain ``moving`` on the chain ``fixed``, whose Cα are now at ``fixed_ca``.
 
+    A chain of the same protein (:func:`core.analysis.compare.pair_by_sequence`) is fitted on
+    its paired Cα, refined on the pairs within :data:`CORE_CUTOFF`; a chain of another
+    protein gets the structural alignment and the superposition of highest TM-score of
+    :func:`core.analysis.fold_alignment.align_folds` (so unrelated folds get one too).
+
     Parameters
     ----------
     fixed_ca : (n_fixed_residues, 3) current Cα of ``fixed`` (edits included), Å.
@@ -98,17 +124,24 @@ def fit_chain(fixed_ca: np.ndarray, fixed: Sequence[BackboneSegment], moving: Se
     Raises
     ------
     ValueError
-        Fewer than 3 residue pairs.
+        Fewer than 3 residue pairs (chains of fewer than 3 residues).
     """
-    pairs_a, pairs_b, pairing = pair_residues(fixed, moving)
-    a, b = fixed_ca[pairs_a], np.concatenate([s.ca for s in moving])[pairs_b]
-    usable = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
-    a, b = a[usable], b[usable]
-    if len(a) < MIN_PAIRS:
-        raise ValueError(f"only {len(a)} residue pair(s) with the edited chain; at least {MIN_PAIRS} are needed")
-    motion, core = fit_closest(a, b, CORE_CUTOFF)
-    distance = np.linalg.norm(a - motion.apply(b), axis=1)
-    return ChainFit(motion, len(a), int(core.sum()), _rms(distance[core]), _rms(distance), pairing)
+    moving_ca = np.concatenate([s.ca for s in moving])
+    pairs_a, pairs_b, pairing = pair_by_sequence(fixed, moving)
+    if pairing == "structure":
+        start = (pairs_a, pairs_b) if len(pairs_a) >= MIN_PAIRS else (None, None)
+        alignment = align_folds(fixed_ca, moving_ca, *start)
+        pairs_a, pairs_b, motion = alignment.pairs_a, alignment.pairs_b, alignment.motion
+    elif len(pairs_a) >= MIN_PAIRS:
+        motion, _ = fit_closest(fixed_ca[pairs_a], moving_ca[pairs_b], CORE_CUTOFF)
+    else:
+        raise ValueError(f"only {len(pairs_a)} residue pair(s) with the edited chain; at least {MIN_PAIRS} are needed")
+    distance = np.linalg.norm(fixed_ca[pairs_a] - motion.apply(moving_ca[pairs_b]), axis=1)
+    cutoff = tm_d8(min(len(fixed_ca), len(moving_ca)))
+    aligned = distance < cutoff
+    rms = float(np.sqrt(np.mean(distance[aligned] ** 2))) if aligned.any() else float("nan")
+    return ChainFit(motion, pairing, len(fixed_ca), len(distance), cutoff, int(aligned.sum()), rms,
+                    tm_score(distance, len(fixed_ca))[0])
 
 
 @dataclass(eq=False)
@@ -312,10 +345,6 @@ class ComparisonView(QObject):
             vtk_to_numpy(target)[:] = np.vstack(values)
             target.Modified()
         mesh.Modified()
-
-
-def _rms(distances: np.ndarray) -> float:
-    return float(np.sqrt(np.mean(distances**2)))
 
 
 def _tangents(samples: np.ndarray) -> np.ndarray:
