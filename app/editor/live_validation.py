@@ -6,7 +6,8 @@ the residues that moved, with what they touch, and folds that local report into 
 current one (:meth:`core.geometry.validation.ValidationReport.updated`); a change that moves more
 than half of the residues is checked in full. Every atom outside a change is where it was
 when the report described it, so the folded report is the report of the current
-coordinates. Views follow :attr:`LiveValidation.updated`.
+coordinates. A structure without a backbone (only viewed) has no report. Views follow
+:attr:`LiveValidation.updated`.
 
 During a drag the report is brought up to date from the event loop, at most every
 :data:`DRAG_INTERVAL_MS` (the residues moved meanwhile are checked together), so a drag
@@ -41,6 +42,7 @@ class LiveValidation(QObject):
         super().__init__(document)
         self.document = document
         self.report: ValidationReport | None = None
+        """None until a structure with a backbone is loaded."""
         self.elapsed_ms = 0.0
         """Time of the last check, ms (a full one after loading, a local one after a change)."""
         self.local = False
@@ -70,7 +72,8 @@ class LiveValidation(QObject):
         self._timer.stop()
         self._pending = None
         start = time.perf_counter()
-        self.report = validate(self.document.structure, self.document.model.coords)
+        editable = self.document.editable
+        self.report = validate(self.document.structure, self.document.model.coords) if editable else None
         self._done(start, local=False, late=late)
 
     def _check_change(self, change: Change) -> None:
