@@ -2,7 +2,8 @@
 
 Panels read the document and follow its signals (refreshing inside signal blockers);
 they change it only through its mutators. Display options belong to the scene. A
-structure that is only viewed (no backbone) leaves the ribbon's controls disabled.
+structure that is only viewed (no backbone) leaves the ribbon's controls disabled and
+shows its atoms.
 """
 
 from __future__ import annotations
@@ -79,18 +80,23 @@ class RibbonDimensionPanel(QWidget):
         slider_row = QHBoxLayout()
         slider_row.addWidget(self.slider, 1)
         slider_row.addWidget(self.spin)
+        switches = QHBoxLayout()  # one row for both: the dock keeps its height with the model row shown
+        switches.addWidget(self.analysis)
+        switches.addWidget(self.integers)
+        switches.addStretch(1)
         self.form = form = QFormLayout()
         form.addRow(self.note)
         form.addRow("Model", self.model_number)
         form.addRow("Segment", self.segment)
         form.addRow("Ribbon", self.kind)
-        form.addRow(self.analysis)
+        form.addRow(switches)
         form.addRow("Level", slider_row)
-        form.addRow(self.integers)
         form.addRow("Shown", self.level_text)
         form.addRow("Curve segments", self.segments_text)
         form.addRow("Control points", self.points_text)
         form.addRow("rms |Cα − C^r|", self.rms_text)
+        form.setRowVisible(self.note, False)  # instead of the figures, for a structure that is only viewed
+        form.setRowVisible(self.model_number, False)  # for a multi-model entry
         layout = QVBoxLayout(self)
         layout.addLayout(form)
         layout.addStretch(1)
@@ -123,6 +129,8 @@ class RibbonDimensionPanel(QWidget):
         self.form.setRowVisible(self.model_number, structure.n_models > 1)
         self.note.setText(document.read_only_reason)
         self.form.setRowVisible(self.note, not document.editable)
+        for label in (self.level_text, self.segments_text, self.points_text, self.rms_text):
+            self.form.setRowVisible(label, document.editable)
         self.segment.setEnabled(self.segment.count() > 1)
         for widget in (self.kind, self.analysis, self.slider, self.spin, self.integers):
             widget.setEnabled(document.editable)
@@ -133,8 +141,6 @@ class RibbonDimensionPanel(QWidget):
         """Show the document's level, segment and the figures of the shown curve."""
         document = self.document
         if not document.editable:
-            for label in (self.level_text, self.segments_text, self.points_text, self.rms_text):
-                label.setText("")
             return
         top = document.max_level
         level = document.shown_level()
@@ -238,11 +244,14 @@ class DisplayPanel(QWidget):
             self._loaded()
 
     def _loaded(self) -> None:
-        """The backbone's layers and colours apply to a structure with a backbone only."""
+        """The backbone's layers and colours apply to a structure with a backbone only; one
+        without shows its atoms."""
         editable = self.scene.document.editable
         for layer in BACKBONE_LAYERS:
             self.layer_boxes[layer].setEnabled(editable)
         self.colours.setEnabled(editable)
+        if not editable:
+            self.layer_boxes[Layer.ATOMS].setChecked(True)
         self._update_legend()
 
     def _colouring_changed(self) -> None:
