@@ -49,7 +49,9 @@ def test_a_protein_document_is_editable_with_no_reason(ubiquitin: Document) -> N
 
 def test_dna_opens_in_the_window_for_viewing_and_surfaces(qtbot: QtBot, tmp_path: Path, errors: list[str]) -> None:
     window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    window.comparison.add(DATA / "1UBQ.pdb.gz")
     assert window.open_file(DNA) and errors == []
+    assert window.comparison.items == []  # nothing to superpose them on
     document, scene = window.document, window.scene
     assert window.windowTitle() == "1BNA.pdb.gz[*] — ribbonwave"
 
