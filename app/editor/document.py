@@ -384,8 +384,9 @@ class Document(QObject):
         return self.model
 
     def _check_editable(self) -> None:
-        if not self.editable:
-            raise ValueError(self.read_only_reason or "no structure is open")
+        """Raise RuntimeError without a structure, ValueError saying why for one only viewed."""
+        if not self._model.ribbons:
+            raise ValueError(self.read_only_reason)
 
     def _set_model(self, model: EditableModel, keep_view: bool = False) -> None:
         """Make ``model`` the document, at the first segment and the default level (or, with

@@ -2,8 +2,8 @@
 
 Every method goes the way the mouse and the menus go: :meth:`EditorAPI.move` is a drag of a
 control point (one undo step, regularized on release when the editor says so), the
-properties set the model of an ensemble, the level slider and the segment, and files are written as File ▸ Save
-writes them. Errors are exceptions, never dialogs.
+properties set the model of an ensemble, the level slider and the segment, and files are
+written as File ▸ Save writes them. Errors are exceptions, never dialogs.
 """
 
 from __future__ import annotations

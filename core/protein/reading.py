@@ -84,7 +84,7 @@ def read_structure(
         ss_source=ss_source,
         chains=chain_summaries(atoms, segments),
         n_models=len(st),
-        model_number=model,
+        model_number=int(model),
         n_hetero_atoms=atoms.n_hetero,
         n_water_atoms=atoms.n_water,
         n_altloc_atoms=atoms.n_altloc,
