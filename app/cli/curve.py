@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from app.arguments import LEVEL, bounded
-from app.cli.structure import chain_segments, load, segment_number
+from app.cli.structure import chain_segments, load, model_argument, segment_number
 from core.protein.ribbon import RibbonKind, segment_ribbon
 
 CURVE_COLUMNS = ("chain", "segment", "resseq", "icode", "resname", "ss",
@@ -23,6 +23,7 @@ CURVE_COLUMNS = ("chain", "segment", "resseq", "icode", "resname", "ss",
 def curve_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, metavar="FILE", help="structure file (PDB or mmCIF, optionally gzipped)")
     parser.add_argument("--chain", metavar="ID", help="only this chain (default: all)")
+    model_argument(parser)
     ribbon_argument(parser)
     parser.add_argument(
         "--level", type=bounded(float, *LEVEL), metavar="L",
@@ -33,7 +34,7 @@ def curve_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_curve(args: argparse.Namespace) -> int:
-    structure = load(args.file)
+    structure = load(args.file, args.model)
     numbers = chain_segments(structure, args.chain)
     rows = []
     for number in numbers:

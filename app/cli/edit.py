@@ -9,7 +9,7 @@ import numpy as np
 
 from app.arguments import LEVEL, bounded
 from app.cli.curve import ribbon_argument
-from app.cli.structure import chain_segments, load
+from app.cli.structure import chain_segments, load, model_argument
 from app.errors import InputError
 from core.geometry.regularize import regularized
 from core.geometry.validation import validate
@@ -20,6 +20,7 @@ from core.protein.structure import BackboneSegment
 
 def edit_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, metavar="FILE", help="structure file (PDB or mmCIF, optionally gzipped)")
+    model_argument(parser)
     parser.add_argument("--chain", required=True, metavar="ID", help="chain to edit")
     parser.add_argument("--segment", type=bounded(int, 0, 100_000), default=0, metavar="S",
                         help="segment of the chain (0-based, chains split at gaps; default 0)")
@@ -39,7 +40,7 @@ def edit_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_edit(args: argparse.Namespace) -> int:
-    structure = load(args.file)
+    structure = load(args.file, args.model)
     number = chain_segments(structure, args.chain, args.segment)[0]
     model = EditableModel(structure, RibbonKind(args.ribbon))
     ribbon = model.ribbons[number]
@@ -59,7 +60,8 @@ def run_edit(args: argparse.Namespace) -> int:
         raise InputError(str(error)) from None
     labels = structure.segments[number].labels
     moved = f"{labels[edit.residues[0]]}-{labels[edit.residues[-1]]}" if len(edit.residues) else "none"
-    print(f"moved {len(edit.residues)} residues ({moved}), {len(edit.rows)} atoms; "
+    of_model = f" of model {structure.model_number}" if structure.n_models > 1 else ""
+    print(f"moved {len(edit.residues)} residues ({moved}), {len(edit.rows)} atoms{of_model}; "
           f"wrote {written}")
     if args.regularize:
         region = structure.segments[number].residue_index[edit.residues]

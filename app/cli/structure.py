@@ -13,15 +13,20 @@ from pathlib import Path
 
 import numpy as np
 
+from app.arguments import bounded
 from app.errors import InputError
 from core.protein.reading import read_structure
 from core.protein.structure import Structure, StructureError
 
+MAX_MODEL = 100_000
+"""Largest ``--model`` accepted before the file is read (PDB model serials stop at 9999)."""
 
-def load(path: Path) -> Structure:
-    """Read a structure, turning reader errors into :class:`InputError`; print its warnings."""
+
+def load(path: Path, model: int = 1) -> Structure:
+    """Read model ``model`` (from 1) of a structure, turning reader errors (a model the file
+    does not have included) into :class:`InputError`; print its warnings."""
     try:
-        structure = read_structure(path)
+        structure = read_structure(path, model=model)
     except StructureError as error:
         raise InputError(str(error)) from None
     for warning in structure.warnings:
@@ -29,11 +34,19 @@ def load(path: Path) -> Structure:
     return structure
 
 
+def model_argument(parser: argparse.ArgumentParser) -> None:
+    """Declare ``--model N``: the model of a multi-model entry (an NMR ensemble) a command reads."""
+    parser.add_argument("--model", type=bounded(int, 1, MAX_MODEL), default=1, metavar="N",
+                        help="model of a multi-model entry (e.g. an NMR ensemble), counted from 1 in file order "
+                             "(default 1)")
+
+
 # ------------------------------------------------------------------------------ info
 
 
 def info_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, metavar="FILE", help="structure file (PDB or mmCIF, optionally gzipped)")
+    model_argument(parser)
     parser.add_argument("--json", action="store_true", help="print a JSON object instead of text")
 
 
@@ -57,6 +70,7 @@ def summary(structure: Structure) -> dict:
         "entry": structure.entry_id,
         "title": structure.title,
         "models": structure.n_models,
+        "model": structure.model_number,
         "atoms": structure.n_atoms,
         "hetero_atoms": structure.n_hetero_atoms,
         "water_atoms": structure.n_water_atoms,
@@ -74,14 +88,15 @@ def summary(structure: Structure) -> dict:
 
 
 def run_info(args: argparse.Namespace) -> int:
-    report = summary(load(args.file))
+    report = summary(load(args.file, args.model))
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
     ss = report["secondary_structure"]
     print(f"{report['file']}: {report['entry']} ({report['format']}), {report['title'] or 'no title'}")
     print(f"  {report['atoms']} atoms ({report['hetero_atoms']} hetero, {report['water_atoms']} water, "
-          f"{report['altloc_atoms']} with altlocs); {report['models']} model(s), the first is used")
+          f"{report['altloc_atoms']} with altlocs); "
+          + (f"model {report['model']} of {report['models']}" if report["models"] > 1 else "1 model"))
     print(f"  {report['residues']} backbone residues: {ss['H']} helix, {ss['E']} sheet, {ss['C']} other "
           f"(from {report['secondary_structure_source']})")
     print(f"  {'chain':<6}{'seg':>4}  {'residues':>8}  {'from':<14}{'to':<14}{'max level':>10}")

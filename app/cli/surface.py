@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from app.arguments import bounded
+from app.cli.structure import model_argument
 from app.errors import InputError
 from app.polydata import scalar_style, to_polydata
 from core.protein.reading import read_atoms
@@ -35,6 +36,7 @@ IDEAL_DNA_REPEAT = "CGCGAATTCGCG"
 def surface_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, nargs="?", metavar="FILE",
                         help="structure (PDB or mmCIF, optionally gzipped), or a CCP4/MRC map for --kind map")
+    model_argument(parser)
     parser.add_argument("--kind", choices=KINDS, default="ses",
                         help="ses: molecular surface (default); globe: sphere-topology spline surface; "
                         "dna: cylinder about the helix axis; remesh: 6·4^L triangles; map: density contour")
@@ -96,7 +98,7 @@ def _inputs(args: argparse.Namespace) -> tuple[AtomTable | None, object]:
             if args.kind != "map":
                 raise InputError(f"{args.file}: a density map can only be shown with --kind map")
             return None, read_map(args.file)
-        return read_atoms(args.file), None
+        return read_atoms(args.file, args.model), None
     except (StructureError, MapError) as error:
         raise InputError(str(error)) from None
 

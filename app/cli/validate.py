@@ -1,7 +1,7 @@
 """The headless ``validate`` command: the geometry report of :mod:`core.geometry.validation`.
 
 ``validate --json`` is a contract for other programs: the fields of
-:meth:`core.geometry.validation.ValidationReport.to_dict` plus ``file``.
+:meth:`core.geometry.validation.ValidationReport.to_dict` plus ``file`` and ``model``.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import argparse
 import json
 from pathlib import Path
 
-from app.cli.structure import load
+from app.cli.structure import load, model_argument
 from app.errors import InputError
 from core.geometry.validation import KINDS, validate
 
@@ -27,22 +27,24 @@ TITLES = {
 
 def validate_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, metavar="FILE", help="structure file (PDB or mmCIF, optionally gzipped)")
+    model_argument(parser)
     parser.add_argument("--json", action="store_true", help="print a JSON object instead of text")
     parser.add_argument("--worst", type=int, default=10, metavar="N",
                         help="list the N most severe problems (default 10; all with --json if N < 0)")
 
 
 def run_validate(args: argparse.Namespace) -> int:
-    structure = load(args.file)
+    structure = load(args.file, args.model)
     report = validate(structure)
     if args.json:
-        data = {"file": str(structure.path)} | report.to_dict(None if args.worst < 0 else args.worst)
+        data = {"file": str(structure.path), "model": structure.model_number} | report.to_dict(None if args.worst < 0 else args.worst)
         print(json.dumps(data, indent=2, ensure_ascii=False))
         return 0
     if args.worst < 0:
         raise InputError(f"--worst must be >= 0 for text output; got {args.worst}")
     counts, checked = report.counts, report.checked
-    print(f"{structure.path}: {structure.entry_id}, {checked['ca_ca']} junctions, "
+    of_model = f" model {structure.model_number} of {structure.n_models}" if structure.n_models > 1 else ""
+    print(f"{structure.path}: {structure.entry_id}{of_model}, {checked['ca_ca']} junctions, "
           f"{checked['ramachandran']} residues with φ/ψ, {checked['clash']} heavy atoms")
     print(f"  {'flagged':>7} {'checked':>8}")
     for kind in KINDS:

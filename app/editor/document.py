@@ -6,6 +6,12 @@ state, and each emits a signal that says what changed, so views can subscribe an
 only what they must. Every edit reaches the model through an undo command
 (:class:`app.editor.commands.EditCommand`); a drag shows previews relative to the state at the
 start of the gesture and pushes one command when it ends.
+
+A document holds one model of its file (:attr:`model_number`; another can be chosen while
+there are no edits to undo). A structure without a protein backbone (DNA) opens for
+viewing only (:attr:`editable` False): the mutators that need a segment raise ValueError
+with :attr:`read_only_reason`, and ``levelChanged``, ``segmentChanged``, ``picked`` and
+``changed`` never come, so views check :attr:`editable` only when a structure is loaded.
 """
 
 from __future__ import annotations
@@ -107,14 +113,39 @@ class Document(QObject):
         return self._model.kind
 
     @property
+    def model_number(self) -> int:
+        """The model of the file shown and edited, 1 .. ``structure.n_models``."""
+        return self.structure.model_number
+
+    @property
+    def editable(self) -> bool:
+        """Whether the structure has a backbone segment to edit (else it is only viewed)."""
+        return self.model is not None and bool(self._model.ribbons)
+
+    @property
+    def read_only_reason(self) -> str:
+        """Why the open structure cannot be edited ('' when it can)."""
+        if self.model is None or self.editable:
+            return ""
+        return f"{self.structure.entry_id} has no protein backbone: viewing only"
+
+    @property
+    def title(self) -> str:
+        """The file's name, with the model for a multi-model entry: ``'1L2Y.pdb.gz (model 3 of 38)'``."""
+        name = self.path.name if self.path is not None else "untitled"
+        if self.model is None or self.structure.n_models == 1:
+            return name
+        return f"{name} (model {self.model_number} of {self.structure.n_models})"
+
+    @property
     def modified(self) -> bool:
         """Edits not saved yet."""
         return self.model is not None and not self.undo_stack.isClean()
 
     @property
     def max_level(self) -> float:
-        """Top of the slider for the current segment, ``log2 N``."""
-        return self._model.ribbons[self.segment].max_level
+        """Top of the slider for the current segment, ``log2 N`` (0 without segments)."""
+        return self._model.ribbons[self.segment].max_level if self.editable else 0.0
 
     def shown_level(self, segment: int | None = None) -> float:
         """Level at which ``segment`` (default: the current one) is shown and edited."""
@@ -156,11 +187,13 @@ class Document(QObject):
 
     # ------------------------------------------------------------------ mutators
 
-    def open(self, path: Path, kind: RibbonKind | str = RibbonKind.PEPTIDE, data: bytes | None = None) -> None:
-        """Read ``path`` (or its content ``data``, already read) and make it the document
-        (raises :class:`core.protein.structure.StructureError`)."""
+    def open(self, path: Path, kind: RibbonKind | str = RibbonKind.PEPTIDE, data: bytes | None = None,
+             model: int = 1) -> None:
+        """Read model ``model`` (1 .. n, in file order) of ``path`` (or of its content ``data``,
+        already read) and make it the document (raises :class:`core.protein.structure.StructureError`).
+        A structure without protein opens for viewing only (see :attr:`editable`)."""
         data = read_bytes(path) if data is None else data
-        self._set_model(EditableModel(read_structure(path, data), kind))
+        self._set_model(EditableModel(read_structure(path, data, model=model, require_protein=False), kind))
         self.path = Path(path)
         self.source = data
         self.save_path = None
@@ -174,8 +207,21 @@ class Document(QObject):
             raise ValueError("the ribbon kind can change only while there are no edits to undo")
         self._set_model(EditableModel(self.structure, kind))
 
+    def set_model_number(self, number: int) -> None:
+        """Show and edit model ``number`` (1 .. n) of the file instead, at the same segment and
+        level; only without edits to undo (else ValueError; StructureError for a model the
+        file does not have)."""
+        if number == self.model_number:
+            return
+        if self.undo_stack.index() > 0:
+            raise ValueError("another model can be chosen only while there are no edits to undo")
+        structure = read_structure(self.structure.path, self.source, model=number, require_protein=False)
+        self._set_model(EditableModel(structure, self.kind), keep_view=True)
+        self.fileChanged.emit()
+
     def set_level(self, level: float) -> None:
         """Set the slider level (clipped to ``[0, log2 N]`` of the current segment)."""
+        self._check_editable()
         level = float(np.clip(level, 0.0, self.max_level))
         if level != self.level:
             self.level = level
@@ -183,12 +229,14 @@ class Document(QObject):
 
     def set_multiresolution(self, on: bool) -> None:
         """Multiresolution analysis on (the slider level) or off (every segment at full resolution)."""
+        self._check_editable()
         if on != self.multiresolution:
             self.multiresolution = on
             self._level_changed()
 
     def set_segment(self, segment: int) -> None:
         """Choose the segment whose control points are shown and edited."""
+        self._check_editable()
         if not 0 <= segment < len(self._model.ribbons):
             raise ValueError(f"segment must be in [0, {len(self._model.ribbons) - 1}]; got {segment}")
         if segment != self.segment:
@@ -203,6 +251,7 @@ class Document(QObject):
         if index is None:
             self._set_pick(None)
             return
+        self._check_editable()
         self._set_pick(Pick(index, self.point_residues(index)))
 
     def point_residues(self, index: int) -> np.ndarray:
@@ -268,6 +317,7 @@ class Document(QObject):
         """Regularize ``residues`` (indices within the current segment) and up to FLANK neighbours
         on each side as one undo step: ideal junctions, on the current curve, and no clash
         that the structure as read did not have."""
+        self._check_editable()
         edit = regularize_region(self._model, self.segment, residues, flank=FLANK)
         if not np.array_equal(edit.old_coords, edit.new_coords):
             self.undo_stack.push(EditCommand(self, edit, f"Regularize {self.residue_range(edit.residues)}"))
@@ -304,17 +354,19 @@ class Document(QObject):
         """The document as records: the file as read, every undo step, the current state."""
         stack = self.undo_stack
         steps = [records.push(k, stack.text(k), stack.command(k).edit) for k in range(stack.count())]
-        return [records.header(self.path, self.kind.value, self.source), *steps, records.Record("index", self.state())]
+        return [records.header(self.path, self.kind.value, self.source, self.model_number), *steps,
+                records.Record("index", self.state())]
 
     def replay(self, recording: list[records.Record]) -> None:
         """Make the document what ``recording`` (:meth:`recording`, or a journal) describes:
-        the file as read, the same undo history at the same position, bit for bit. Views
-        are told once, at the end. Raises StructureError for an unreadable embedded file."""
+        the file as read (the same model), the same undo history at the same position, bit
+        for bit. Views are told once, at the end. Raises StructureError for an unreadable
+        embedded file."""
         head, files, view = recording[0].fields, None, None
         self.replaying = True
         try:
             with QSignalBlocker(self):
-                self.open(Path(head["path"]), head["kind"], records.source_of(recording[0]))
+                self.open(Path(head["path"]), head["kind"], records.source_of(recording[0]), records.model_of(head))
                 stack = self.undo_stack
                 for record in recording[1:]:
                     if record.kind == "push":
@@ -328,13 +380,14 @@ class Document(QObject):
                 if files is not None:
                     self._restore_files(files)
                 if view is not None:
-                    self.segment = min(int(view["segment"]), len(self._model.ribbons) - 1)
+                    self.segment = max(0, min(int(view["segment"]), len(self._model.ribbons) - 1))
                     self.multiresolution = bool(view["multiresolution"])
                     self.level = float(np.clip(view["level"], 0.0, self.max_level))
         finally:
             self.replaying = False
-        for signal in (self.loaded, self.segmentChanged, self.levelChanged, self.fileChanged):
+        for signal in (self.loaded, self.segmentChanged, self.levelChanged) if self.editable else (self.loaded,):
             signal.emit()
+        self.fileChanged.emit()
 
     def _restore_files(self, state: dict) -> None:
         """The clean position and the file names of an ``index`` record."""
@@ -357,13 +410,22 @@ class Document(QObject):
             raise RuntimeError("no structure is open")
         return self.model
 
-    def _set_model(self, model: EditableModel) -> None:
+    def _check_editable(self) -> None:
+        """Raise RuntimeError without a structure, ValueError saying why for one only viewed."""
+        if not self._model.ribbons:
+            raise ValueError(self.read_only_reason)
+
+    def _set_model(self, model: EditableModel, keep_view: bool = False) -> None:
+        """Make ``model`` the document, at the first segment and the default level (or, with
+        ``keep_view``, at the segment and level shown, where the new model has them)."""
+        segment, level = self.segment, self.level
         self.undo_stack.clear()
         self.model = model
         self.paths = [SegmentPath(ribbon) for ribbon in model.ribbons]
         self.ca_rows = ca_rows(model.structure)
-        self.segment = 0
-        self.level = float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
+        self.segment = segment if keep_view and segment < len(model.ribbons) else 0
+        default = float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
+        self.level = min(level, self.max_level) if keep_view else default
         self.pick = None
         self.selection = np.empty(0, dtype=np.int64)
         self._preview = None
@@ -371,6 +433,7 @@ class Document(QObject):
         self.loaded.emit()
 
     def _preview_edit(self, plan: Callable[[], Edit]) -> None:
+        self._check_editable()
         previous = self._preview
         if previous is not None:
             self._model.revert(previous)

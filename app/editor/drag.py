@@ -5,7 +5,7 @@ pointer and the camera's viewing direction. :class:`DragController` picks what t
 ray hits (a control point of the curve shown at the current level, or that curve itself),
 moves it in the plane through the grabbed point facing the camera, asks the document for
 a preview of the edit relative to the state at the press, and ends the gesture with one
-undo step. Presses that hit nothing are left to the camera.
+undo step. Presses that hit nothing, or come while nothing can be edited, are left to the camera.
 """
 
 from __future__ import annotations
@@ -141,7 +141,7 @@ class DragController:
             self.document.cancel_drag()
 
     def _press(self, event: PointerEvent) -> _Grab | None:
-        if self.document.model is None:
+        if not self.document.editable:
             return None
         curve = self.document.level_curve()
         if self.mode is Mode.POINT:

@@ -48,7 +48,7 @@ def identify(document: Document, event: PointerEvent, *, points: bool, point_rad
     ``point_radius`` Å), one of the atoms of rows ``atoms``, or a residue."""
     if document.model is None:
         return None
-    if points:
+    if points and document.editable:
         curve = document.level_curve()
         index = _front_hit(event, curve.control_points, point_radius, curve.visible)
         if index is not None:
@@ -60,6 +60,8 @@ def identify(document: Document, event: PointerEvent, *, points: bool, point_rad
     if atom is not None:
         row = int(atoms[atom])
         return Hit("atom", coords[row], int(document.structure.atom_residue[row]), row)
+    if not document.editable:
+        return None
     ca = coords[document.ca_rows]
     residue = _front_hit(event, ca, RESIDUE_RADIUS)
     return None if residue is None else Hit("residue", ca[residue], residue)

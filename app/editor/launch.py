@@ -23,6 +23,8 @@ if TYPE_CHECKING:
     from app.editor.main_window import MainWindow
 
 MAX_SCRIPT_BYTES = 16 * 2**20
+MAX_MODEL = 100_000
+"""Largest ``--model`` accepted before the file is read."""
 WINDOWLESS_PLATFORMS = ("offscreen", "minimal", "minimalegl", "linuxfb", "vnc")
 """Qt platforms that cannot hold the OpenGL view of the editor."""
 
@@ -60,6 +62,13 @@ def open_arguments(parser: argparse.ArgumentParser) -> None:
         "--overwrite",
         action="store_true",
         help="replace the --screenshot image if it exists",
+    )
+    parser.add_argument(
+        "--model",
+        type=bounded(int, 1, MAX_MODEL),
+        default=1,
+        metavar="N",
+        help="model of a multi-model entry (e.g. an NMR ensemble) to show and edit, counted from 1 (default 1)",
     )
     parser.add_argument(
         "--level",
@@ -158,13 +167,16 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
             raise InputError(str(error)) from error
     else:
         try:
-            window.document.open(args.file, args.ribbon)
+            window.document.open(args.file, args.ribbon, model=args.model)
         except StructureError as error:
             raise InputError(str(error)) from error
         if args.file != DEFAULT_STRUCTURE:
             window.add_recent(args.file)
     if args.level is not None:
-        window.document.set_level(args.level)
+        try:
+            window.document.set_level(args.level)
+        except ValueError as error:  # a structure only viewed has no level
+            raise InputError(f"--level: {error}") from error
     for name in args.hide:
         layer = Layer.__members__.get(name.upper().replace("-", "_"))
         if layer is None:

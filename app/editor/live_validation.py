@@ -6,7 +6,8 @@ the residues that moved, with what they touch, and folds that local report into 
 current one (:meth:`core.geometry.validation.ValidationReport.updated`); a change that moves more
 than half of the residues is checked in full. Every atom outside a change is where it was
 when the report described it, so the folded report is the report of the current
-coordinates. Views follow :attr:`LiveValidation.updated`.
+coordinates. A structure without a backbone (only viewed) has no report. Views follow
+:attr:`LiveValidation.updated`.
 
 The first full check of a structure is also its :attr:`~LiveValidation.baseline` (the
 structure as read; a replayed session is checked as read once more): each flag of a later
@@ -51,6 +52,7 @@ class LiveValidation(QObject):
         super().__init__(document)
         self.document = document
         self.report: ValidationReport | None = None
+        """None until a structure with a backbone is loaded."""
         self.baseline: Baseline | None = None
         """The flags of the structure as read."""
         self.triage_filter = TriageFilter()
@@ -98,11 +100,15 @@ class LiveValidation(QObject):
         self._timer.stop()
         self._pending = None
         start = time.perf_counter()
-        structure, coords = self.document.structure, self.document.model.coords
-        self.report = validate(structure, coords)
-        if self.baseline is None:  # the first check of this structure
-            as_read = np.array_equal(coords, structure.coords)
-            self.baseline = Baseline.of(self.report if as_read else validate(structure))
+        structure = self.document.structure
+        if not self.document.editable:
+            self.report = None
+        else:
+            coords = self.document.model.coords
+            self.report = validate(structure, coords)
+            if self.baseline is None:  # the first check of this structure
+                as_read = np.array_equal(coords, structure.coords)
+                self.baseline = Baseline.of(self.report if as_read else validate(structure))
         self._done(start, local=False, late=late)
 
     def _check_change(self, change: Change) -> None:
@@ -134,5 +140,5 @@ class LiveValidation(QObject):
         self.elapsed_ms = 1e3 * (self._finished - start)
         self.local = local
         self.late = late
-        self.triaged = triage(self.report, self.baseline, self.triage_filter)
+        self.triaged = None if self.report is None else triage(self.report, self.baseline, self.triage_filter)
         self.updated.emit()

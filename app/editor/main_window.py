@@ -752,8 +752,7 @@ class MainWindow(QMainWindow):
         clear.triggered.connect(lambda: self.settings.setValue(RECENT_KEY, []))
 
     def _update_title(self) -> None:
-        path = self.document.path
-        self.setWindowTitle(f"{path.name if path else 'untitled'}[*] — {APP_NAME}")
+        self.setWindowTitle(f"{self.document.title}[*] — {APP_NAME}")
         self.setWindowModified(self.document.modified)
         self._update_status()
 
@@ -765,6 +764,12 @@ class MainWindow(QMainWindow):
             return
         structure = document.structure
         labels["file"].setText(f"{document.path.name if document.path else ''}  ({structure.entry_id})")
+        self.mode_actions.setEnabled(document.editable)
+        if not document.editable:  # only viewed: say why instead of the segment, level and pick
+            labels["segment"].clear()
+            labels["level"].clear()
+            labels["pick"].setText(document.read_only_reason)
+            return
         labels["segment"].setText(f"chain {document.segment_label(document.segment)}")
         labels["level"].setText(f"level {document.shown_level():.2f} / {document.max_level:.2f}")
         pick = document.pick

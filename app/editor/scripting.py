@@ -2,8 +2,8 @@
 
 Every method goes the way the mouse and the menus go: :meth:`EditorAPI.move` is a drag of a
 control point (one undo step, regularized on release when the editor says so), the
-properties set the level slider and the segment, and files are written as File ▸ Save
-writes them. Errors are exceptions, never dialogs.
+properties set the model of an ensemble, the level slider and the segment, and files are
+written as File ▸ Save writes them. Errors are exceptions, never dialogs.
 """
 
 from __future__ import annotations
@@ -33,7 +33,25 @@ class EditorAPI:
             raise RuntimeError("no structure is open: rw.open(path) first")
         return document
 
+    @property
+    def _editable(self) -> Document:
+        """The document, if it can be edited (else ValueError saying why)."""
+        document = self._document
+        if not document.editable:
+            raise ValueError(document.read_only_reason)
+        return document
+
     # ------------------------------------------------------------------ state
+
+    @property
+    def model(self) -> int:
+        """The model of a multi-model entry shown and edited (1 .. n, in file order); it can
+        change while there are no edits to undo (else ValueError)."""
+        return self._document.model_number
+
+    @model.setter
+    def model(self, value: int) -> None:
+        self._document.set_model_number(value)
 
     @property
     def level(self) -> float:
@@ -55,7 +73,7 @@ class EditorAPI:
 
     def points(self) -> np.ndarray:
         """(n, 3) control points of the curve shown (the current segment at its level), Å."""
-        return self._document.level_curve().control_points.copy()
+        return self._editable.level_curve().control_points.copy()
 
     def coords(self) -> np.ndarray:
         """(n_atoms, 3) every atom of the edited structure, Å."""
@@ -83,7 +101,7 @@ class EditorAPI:
 
     def move(self, index: int, delta: object) -> None:
         """Drag control point ``index`` of the curve shown by ``delta`` (Å): one undo step."""
-        document = self._document
+        document = self._editable
         points = document.level_curve().control_points
         if not 0 <= int(index) < len(points):
             raise IndexError(f"control point {index} does not exist: the curve shown has {len(points)}")
@@ -94,7 +112,7 @@ class EditorAPI:
     def tug(self, residue: int | str, delta: object) -> None:
         """Tug the curve shown at ``residue`` (index in the segment, or a label such as
         ``'A:LYS48'`` or ``'48'``) by ``delta`` (Å): one undo step, as *Tug the curve* does."""
-        document = self._document
+        document = self._editable
         labels = document.labels()
         index = _residue_index(labels, residue)
         document.preview_tug(float(document.paths[document.segment].residue_u[index]), _vector(delta))

@@ -37,14 +37,19 @@ _BACKBONE = ("N", "CA", "C", "O")
 _PEPTIDE = (gemmi.PolymerType.PeptideL, gemmi.PolymerType.PeptideD)
 
 
-def read_structure(path: str | os.PathLike[str], data: bytes | None = None) -> Structure:
-    """Read a PDB or mmCIF file (optionally gzipped); the format is taken from the content.
+def read_structure(
+    path: str | os.PathLike[str], data: bytes | None = None, *, model: int = 1, require_protein: bool = True
+) -> Structure:
+    """Read one model of a PDB or mmCIF file (optionally gzipped); the format is taken from the content.
 
     Parameters
     ----------
     path : str or path-like
     data : the file's content (as :func:`read_bytes` gives it) if already read; ``path`` then
         only names it, and need not exist.
+    model : which model, 1 .. ``n_models`` in file order (default the first).
+    require_protein : refuse an entry without a protein chain (else it reads with no
+        segments, e.g. DNA to look at).
 
     Returns
     -------
@@ -53,20 +58,20 @@ def read_structure(path: str | os.PathLike[str], data: bytes | None = None) -> S
     Raises
     ------
     StructureError
-        Missing, empty or unreadable file, no atoms, no protein chain, or non-finite
-        coordinates; the message names the file.
+        Missing, empty or unreadable file, no such model, no atoms, no protein chain (if
+        required), or non-finite coordinates; the message names the file.
     """
     path = Path(path)
-    text, encoding, fmt, st, atoms = _read_model(path, read_bytes(path) if data is None else data)
+    text, encoding, fmt, st, atoms = _read_model(path, read_bytes(path) if data is None else data, model)
     notes: list[str] = []
     groups = residue_groups(atoms)
     runs = backbone_runs(atoms, groups, notes)
-    if not runs:
+    if not runs and require_protein:
         raise StructureError(
             f"{path}: no protein chain (no two consecutive amino-acid residues with Cα)"
         )
-    rows = np.concatenate(runs)
-    ss, ss_source = secondary_structure(st, fmt, atoms, groups, runs, notes)
+    rows = np.concatenate(runs) if runs else np.empty(0, dtype=np.int64)
+    ss, ss_source = secondary_structure(st, fmt, atoms, groups, runs, notes) if runs else (np.empty(0, str), "")
     segments = make_segments(atoms, groups, runs, ss)
     return Structure(
         path=path,
@@ -79,6 +84,7 @@ def read_structure(path: str | os.PathLike[str], data: bytes | None = None) -> S
         ss_source=ss_source,
         chains=chain_summaries(atoms, segments),
         n_models=len(st),
+        model_number=int(model),
         n_hetero_atoms=atoms.n_hetero,
         n_water_atoms=atoms.n_water,
         n_altloc_atoms=atoms.n_altloc,
@@ -90,28 +96,32 @@ def read_structure(path: str | os.PathLike[str], data: bytes | None = None) -> S
     )
 
 
-def read_atoms(path: str | os.PathLike[str]) -> AtomTable:
-    """Read every atom of the first model of a PDB or mmCIF file (optionally gzipped).
+def read_atoms(path: str | os.PathLike[str], model: int = 1) -> AtomTable:
+    """Read every atom of one model (1 .. n, default the first) of a PDB or mmCIF file (optionally gzipped).
 
     Unlike :func:`read_structure` this needs no protein chain (e.g. a DNA duplex).
 
     Raises
     ------
     StructureError
-        Missing, empty or unreadable file, no atoms, or non-finite coordinates.
+        Missing, empty or unreadable file, no such model, no atoms, or non-finite coordinates.
     """
     path = Path(path)
-    _, _, _, st, atoms = _read_model(path, read_bytes(path))
+    _, _, _, st, atoms = _read_model(path, read_bytes(path), model)
     return _atom_table(st.name, atoms)
 
 
-def _read_model(path: Path, data: bytes) -> tuple[str, str, str, gemmi.Structure, ScannedModel]:
-    """Text, its encoding, format, parsed structure and scanned first model of a file with finite atoms."""
+def _read_model(path: Path, data: bytes, model: int) -> tuple[str, str, str, gemmi.Structure, ScannedModel]:
+    """Text, its encoding, format, parsed structure and scanned model ``model`` (from 1) of a
+    file with finite atoms."""
     text, encoding = _text(path, data)
     fmt = "mmcif" if _looks_like_mmcif(text) else "pdb"
     st = _parse(text, fmt, path)
+    if isinstance(model, bool) or not isinstance(model, (int, np.integer)) or not 1 <= model <= len(st):
+        raise StructureError(f"{path}: no model {model!r}; the file has {len(st)} model(s), "
+                             f"numbered 1 to {len(st)} in file order")
     try:
-        atoms = scan_model(st[0])
+        atoms = scan_model(st[int(model) - 1])
     except (TypeError, ValueError, RuntimeError) as exc:  # e.g. a residue gemmi left without a number
         raise StructureError(f"{path}: cannot read the atoms ({exc})") from None
     if len(atoms.coords) == 0:

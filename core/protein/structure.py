@@ -6,14 +6,17 @@ written back by :mod:`core.protein.writing` (the only modules that touch gemmi, 
 Conventions
 -----------
 - Lengths in Å; coordinate arrays are float64 ``(n, 3)`` and read-only.
-- ``Structure.coords`` lists every atom of the first model in gemmi's traversal order
-  (chain, residue, atom, i.e. file order): all alternate locations, hydrogens, hetero
-  groups, waters, nucleic acids.
+- A structure is one model of its file (``Structure.model_number``, counted from 1 in file
+  order; the first unless asked). ``Structure.coords`` lists every atom of that model in
+  gemmi's traversal order (chain, residue, atom, i.e. file order): all alternate
+  locations, hydrogens, hetero groups, waters, nucleic acids.
 - Backbone residues are numbered 0 .. n_residues-1 over all segments in order (the
   *residue table*); ``Structure.atom_residue`` maps each atom to that number or -1.
 - The backbone arrays use the first conformer (the first altloc met in the residue; the
   first residue of a group sharing one sequence number), but a residue's atom range
   covers all of its atoms and alternate conformers, so they move together.
+- An entry without a protein chain (DNA) has no segments; only readers that are asked
+  to read one give such a structure.
 - A protein chain is cut into segments where consecutive Cα atoms are more than
   :data:`MAX_CA_STEP` apart; residues without Cα are skipped and one-residue segments are
   dropped, each with a message in ``Structure.warnings`` (their atoms keep
@@ -170,7 +173,7 @@ class AtomTable:
 
 @dataclass(frozen=True, eq=False)
 class Structure:
-    """The first model of a PDB/mmCIF entry as arrays; see the module docstring.
+    """One model of a PDB/mmCIF entry as arrays; see the module docstring.
 
     Attributes
     ----------
@@ -181,18 +184,21 @@ class Structure:
     entry_id, title : str
         PDB id (or the file name) and title ('' if none).
     coords : (n_atoms, 3) float64, Å
-        Every atom of the first model in traversal order.
+        Every atom of the model in traversal order.
     atom_residue : (n_atoms,) int64
         Residue-table row of each atom, -1 for atoms outside the backbone segments.
     segments : tuple of BackboneSegment
+        Empty for an entry without protein (read with ``require_protein=False``).
     ss_source : str
-        One of SS_FROM_PDB_RECORDS, SS_FROM_MMCIF, SS_COMPUTED.
+        One of SS_FROM_PDB_RECORDS, SS_FROM_MMCIF, SS_COMPUTED ('' without segments).
     chains : tuple of ChainSummary
         In order of first appearance.
     n_models : int
-        Models in the file (only the first is read and edited).
+        Models in the file.
+    model_number : int
+        The model read, 1 .. n_models in file order; writing replaces its atoms only.
     n_hetero_atoms, n_water_atoms, n_altloc_atoms : int
-        First-model atoms of non-water HETATM groups, of waters, and with an altloc.
+        Atoms of the model of non-water HETATM groups, of waters, and with an altloc.
     warnings : tuple of str
         What was skipped or ignored while reading.
     atoms : AtomTable
@@ -209,6 +215,7 @@ class Structure:
     ss_source: str
     chains: tuple[ChainSummary, ...]
     n_models: int
+    model_number: int
     n_hetero_atoms: int
     n_water_atoms: int
     n_altloc_atoms: int
@@ -221,7 +228,7 @@ class Structure:
 
     @property
     def n_atoms(self) -> int:
-        """Atoms of the first model (rows of ``coords``)."""
+        """Atoms of the model (rows of ``coords``)."""
         return len(self.coords)
 
     @property

@@ -49,14 +49,17 @@ def write_structure(
     *,
     overwrite: bool = False,
 ) -> Path:
-    """Write ``structure`` with its first-model atoms moved to ``coords``.
+    """Write ``structure`` with the atoms of its model moved to ``coords``.
 
     Everything else is kept: header records, SEQRES, HELIX/SHEET, SSBOND/LINK, CONECT,
     hetero groups, waters, B-factors, occupancies, altlocs, numbering (auth and label
     ids in mmCIF) and the other models of a multi-model entry (unchanged). Anisotropic
     displacement parameters are written as read (not rotated with moved residues).
-    mmCIF input written as mmCIF keeps every category of the input; only the atom
-    records are regenerated.
+    Written in its own format, a file changes only in the coordinates of the atoms that
+    moved (and, in PDB, the SSBOND, LINK and CISPEP records whose distance or angle they
+    change): every other byte, the other models' included, stays as read, and an unmoved
+    structure is written byte for byte. Otherwise (or when the atom records are not laid
+    out as read) gemmi writes the atoms; mmCIF input keeps every category of the input.
 
     Parameters
     ----------
@@ -92,12 +95,12 @@ def write_structure(
         raise FileExistsError(
             f"{path}: refusing to overwrite {'the input file' if same else 'an existing file'}"
         )
-    text = _patched_atom_site(structure._text, structure.coords, coords) if (fmt, structure.source_format) == (
-        "mmcif", "mmcif") else None
     try:
+        text = None
+        if fmt == structure.source_format:
+            text = (_patched_atom_site if fmt == "mmcif" else _patched_pdb)(structure, coords)
         if text is None:
-            st = structure._template.clone()
-            _set_positions(st[0], coords)
+            st = _moved(structure, coords)
             moved = not np.array_equal(coords, structure.coords)
             text = _pdb_text(st, structure, moved) if fmt == "pdb" else _mmcif_text(st, structure)
     except RuntimeError as exc:
@@ -146,12 +149,15 @@ def _output_format(path: Path) -> tuple[str, bool]:
     raise StructureError(f"{path}: unknown extension; use .pdb, .ent, .cif or .mmcif (optionally + .gz)")
 
 
-def _set_positions(model: gemmi.Model, coords: np.ndarray) -> None:
+def _moved(structure: Structure, coords: np.ndarray) -> gemmi.Structure:
+    """A copy of the parsed file with the atoms of the structure's model at ``coords``."""
+    st = structure._template.clone()
     rows = iter(np.round(coords, 3).tolist())
-    for ch in model:
+    for ch in st[structure.model_number - 1]:
         for res in ch:
             for atom in res:
                 atom.pos = gemmi.Position(*next(rows))
+    return st
 
 
 def _pdb_text(st: gemmi.Structure, structure: Structure, moved: bool) -> str:
@@ -195,6 +201,55 @@ def _record(line: str) -> str:
     return line[:6].strip()
 
 
+_ATOM_RECORDS = ("ATOM  ", "HETATM")
+_COLUMNS = (30, 38, 46)
+"""Where the x, y and z fields (8 characters each) of a PDB atom record start."""
+
+
+def _patched_pdb(structure: Structure, coords: np.ndarray) -> str | None:
+    """The PDB input with only the coordinates (columns 31-54) of the model's atoms that
+    moved rewritten, and the SSBOND, LINK and CISPEP records whose distance or angle gemmi
+    finds changed: every other byte stays as read. None when the atom records of the model
+    are not the atoms read, in that order (then gemmi writes the file)."""
+    text, read = structure._text, structure.coords
+    moved = np.flatnonzero(np.any(coords != read, axis=1))
+    if not len(moved):
+        return text
+    lines = text.splitlines(keepends=True)
+    model, rows = 0, []
+    for k, line in enumerate(lines):
+        if _record(line) == "MODEL":
+            model += 1
+        elif line.startswith(_ATOM_RECORDS) and max(model, 1) == structure.model_number:
+            rows.append(k)
+    if len(rows) != len(read):
+        return None
+    try:
+        values = np.array([[float(lines[k][c : c + 8]) for c in _COLUMNS] for k in rows]).reshape(-1, 3)
+    except ValueError:
+        return None
+    if not np.allclose(values, read, rtol=0, atol=1e-6):
+        return None
+    for atom, xyz in zip(moved, np.round(coords[moved], 3) + 0.0):  # + 0.0: no "-0.000"
+        lines[rows[atom]] = lines[rows[atom]][:30] + "".join(f"{v:8.3f}" for v in xyz) + lines[rows[atom]][54:]
+    before, after = _geometry_records(structure._template), _geometry_records(_moved(structure, coords))
+    changed = [k for k, (old, new) in enumerate(zip(before, after)) if old != new]
+    at = [k for k, line in enumerate(lines) if _record(line) in _AS_READ_UNMOVED]
+    if changed and [_record(lines[k]) for k in at] != [_record(line) for line in after]:
+        return None  # the input's records are not gemmi's, one for one
+    for k in changed:
+        line = lines[at[k]]
+        lines[at[k]] = after[k] + line[len(line.rstrip("\r\n")):]
+    return "".join(lines)
+
+
+def _geometry_records(st: gemmi.Structure) -> list[str]:
+    """gemmi's SSBOND, LINK and CISPEP lines of ``st``, with distances and angles from its atoms."""
+    options = gemmi.PdbWriteOptions()
+    options.atom_records = options.seqres_records = options.conect_records = False
+    return [line for line in st.make_pdb_string(options).splitlines() if _record(line) in _AS_READ_UNMOVED]
+
+
 def _mmcif_text(st: gemmi.Structure, structure: Structure) -> str:
     """gemmi's mmCIF of ``st``: for mmCIF input, the input's categories with the atoms
     written anew (when :func:`_patched_atom_site` cannot patch them in place)."""
@@ -209,11 +264,12 @@ def _mmcif_text(st: gemmi.Structure, structure: Structure) -> str:
 _TOKEN = re.compile(r"""'[^']*'(?=\s|$)|"[^"]*"(?=\s|$)|\S+""")
 
 
-def _patched_atom_site(text: str, read: np.ndarray, coords: np.ndarray) -> str | None:
-    """The mmCIF ``text`` with only the coordinates of the first-model atoms that moved
-    rewritten, each with as many decimals as it had (3 at least): every other byte stays as
-    read. None when the ``_atom_site`` loop is not laid out one atom per line in the order
-    read (then gemmi writes the atoms)."""
+def _patched_atom_site(structure: Structure, coords: np.ndarray) -> str | None:
+    """The mmCIF input with only the coordinates of the model's atoms that moved rewritten,
+    each with as many decimals as it had (3 at least): every other byte stays as read. None
+    when the ``_atom_site`` loop is not laid out one atom per line in the order read (then
+    gemmi writes the atoms)."""
+    text, read = structure._text, structure.coords
     lines = text.splitlines(keepends=True)
     start = next((k for k, line in enumerate(lines) if line.startswith("_atom_site.")), None)
     if start is None or start == 0 or lines[start - 1].strip() != "loop_":
@@ -231,8 +287,12 @@ def _patched_atom_site(text: str, read: np.ndarray, coords: np.ndarray) -> str |
     if any(len(tokens) != len(tags) for tokens in rows):
         return None  # a row over several lines
     if "pdbx_PDB_model_num" in tags:
-        model = tags.index("pdbx_PDB_model_num")
-        kept = [k for k, tokens in enumerate(rows) if tokens[model] == rows[0][model]] if rows else []
+        column = tags.index("pdbx_PDB_model_num")
+        numbers = list(dict.fromkeys(tokens[column] for tokens in rows))  # in file order
+        if len(numbers) < structure.model_number:
+            return None
+        chosen = numbers[structure.model_number - 1]
+        kept = [k for k, tokens in enumerate(rows) if tokens[column] == chosen]
     else:
         kept = list(range(len(rows)))
     if len(kept) != len(read):

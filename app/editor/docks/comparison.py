@@ -100,7 +100,7 @@ class ComparisonPanel(QWidget):
     def add_dialog(self) -> None:
         """Ask for structure files and add them; problems are reported in one message box."""
         document = self.comparison.document
-        if document.model is None:
+        if not document.editable:
             return
         folder = str(document.path.parent) if document.path else str(Path.home())
         names, _ = QFileDialog.getOpenFileNames(self, "Add Structures for Comparison", folder, STRUCTURE_FILTER)
@@ -181,8 +181,10 @@ class ComparisonPanel(QWidget):
 
     def _update_level(self) -> None:
         document = self.comparison.document
-        if document.model is None:
-            self.level_text.setText("Open a structure first.")
+        self.add_button.setEnabled(document.editable)
+        if not document.editable:
+            self.level_text.setText(f"{document.read_only_reason}: no chain to compare with."
+                                    if document.model is not None else "Open a structure first.")
             return
         depth = self.comparison.depth
         self.level_text.setText(f"Each at {depth:.2f} levels below its own log₂ N (same depth as the edited segment)")

@@ -1,7 +1,9 @@
 """Dock panels: the "ribbon dimension" controls and the display options.
 
 Panels read the document and follow its signals (refreshing inside signal blockers);
-they change it only through its mutators. Display options belong to the scene.
+they change it only through its mutators. Display options belong to the scene. A
+structure that is only viewed (no backbone) leaves the ribbon's controls disabled and
+shows its atoms.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QSlider,
+    QSpinBox,
     QVBoxLayout,
     QWidget,
 )
@@ -34,14 +37,22 @@ from core.protein.ribbon import RibbonKind
 STEPS_PER_LEVEL = 100
 """Slider positions per level: fractional levels in steps of 0.01."""
 KIND_NAMES = {RibbonKind.PEPTIDE: "peptide-plane ribbon", RibbonKind.CALPHA: "Cα ribbon"}
+BACKBONE_LAYERS = (Layer.TUBE, Layer.CURVE, Layer.CONTROL_POINTS, Layer.CA_TRACE)
+"""Layers drawn from the backbone: nothing to show for a structure that is only viewed."""
 
 
 class RibbonDimensionPanel(QWidget):
-    """Multiresolution analysis on/off, the level slider and what the level means."""
+    """The model of an ensemble, multiresolution analysis on/off, the level slider and what the level means."""
 
     def __init__(self, document: Document, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.document = document
+        self.note = QLabel()
+        self.note.setWordWrap(True)
+        self.model_number = QSpinBox()
+        self.model_number.setKeyboardTracking(False)  # a typed model number counts on Enter or focus-out
+        self.model_number.setToolTip("Model of the multi-model entry (e.g. an NMR ensemble) shown and edited; "
+                                     "can change while there are no edits to undo")
         self.segment = QComboBox()
         self.segment.setToolTip("Backbone segment whose control points are shown and edited")
         self.kind = QComboBox()
@@ -70,20 +81,28 @@ class RibbonDimensionPanel(QWidget):
         slider_row = QHBoxLayout()
         slider_row.addWidget(self.slider, 1)
         slider_row.addWidget(self.spin)
-        form = QFormLayout()
+        switches = QHBoxLayout()  # one row for both: the dock keeps its height with the model row shown
+        switches.addWidget(self.analysis)
+        switches.addWidget(self.integers)
+        switches.addStretch(1)
+        self.form = form = QFormLayout()
+        form.addRow(self.note)
+        form.addRow("Model", self.model_number)
         form.addRow("Segment", self.segment)
         form.addRow("Ribbon", self.kind)
-        form.addRow(self.analysis)
+        form.addRow(switches)
         form.addRow("Level", slider_row)
-        form.addRow(self.integers)
         form.addRow("Shown", self.level_text)
         form.addRow("Curve segments", self.segments_text)
         form.addRow("Control points", self.points_text)
         form.addRow("rms |Cα − C^r|", self.rms_text)
+        form.setRowVisible(self.note, False)  # instead of the figures, for a structure that is only viewed
+        form.setRowVisible(self.model_number, False)  # for a multi-model entry
         layout = QVBoxLayout(self)
         layout.addLayout(form)
         layout.addStretch(1)
 
+        self.model_number.valueChanged.connect(self._model_chosen)
         self.segment.currentIndexChanged.connect(self._segment_chosen)
         self.kind.currentIndexChanged.connect(self._kind_chosen)
         self.analysis.toggled.connect(document.set_multiresolution)
@@ -100,18 +119,29 @@ class RibbonDimensionPanel(QWidget):
 
     def _reload(self) -> None:
         document = self.document
-        with QSignalBlocker(self.segment), QSignalBlocker(self.kind):
+        structure = document.structure
+        with QSignalBlocker(self.segment), QSignalBlocker(self.kind), QSignalBlocker(self.model_number):
             self.segment.clear()
-            self.segment.addItems([document.segment_label(g) for g in range(len(document.structure.segments))])
+            self.segment.addItems([document.segment_label(g) for g in range(len(structure.segments))])
             self.kind.setCurrentIndex(self.kind.findData(document.kind))
+            self.model_number.setRange(1, structure.n_models)
+            self.model_number.setSuffix(f" of {structure.n_models}")
+            self.model_number.setValue(document.model_number)
+        self.form.setRowVisible(self.model_number, structure.n_models > 1)
+        self.note.setText(document.read_only_reason)
+        self.form.setRowVisible(self.note, not document.editable)
+        for label in (self.level_text, self.segments_text, self.points_text, self.rms_text):
+            self.form.setRowVisible(label, document.editable)
         self.segment.setEnabled(self.segment.count() > 1)
-        self.kind.setEnabled(document.undo_stack.index() == 0)
+        for widget in (self.kind, self.analysis, self.slider, self.spin, self.integers):
+            widget.setEnabled(document.editable)
+        self._history_moved(document.undo_stack.index())
         self.refresh()
 
     def refresh(self) -> None:
         """Show the document's level, segment and the figures of the shown curve."""
         document = self.document
-        if document.model is None:
+        if not document.editable:
             return
         top = document.max_level
         level = document.shown_level()
@@ -132,6 +162,9 @@ class RibbonDimensionPanel(QWidget):
         self.points_text.setText(f"{int(curve.visible.sum())} shown of {len(curve.control_points)}")
         self.rms_text.setText(f"{document.deviation():.2f} Å")
 
+    def _model_chosen(self, number: int) -> None:
+        self.document.set_model_number(number)
+
     def _segment_chosen(self, index: int) -> None:
         if index >= 0:
             self.document.set_segment(index)
@@ -148,7 +181,9 @@ class RibbonDimensionPanel(QWidget):
             self.refresh()
 
     def _history_moved(self, index: int) -> None:
-        self.kind.setEnabled(index == 0)
+        """The ribbon kind and the model can change while there are no edits to undo."""
+        self.kind.setEnabled(index == 0 and self.document.editable)
+        self.model_number.setEnabled(index == 0)
 
     def _set_level(self, level: float) -> None:
         if self.integers.isChecked():
@@ -211,9 +246,21 @@ class DisplayPanel(QWidget):
         self.colouring.currentIndexChanged.connect(self._colouring_changed)
         self.fat.toggled.connect(scene.set_fat_helices)
         self.others.currentIndexChanged.connect(lambda: scene.set_others(self.others.currentData()))
-        scene.document.loaded.connect(self._update_legend)
+        self.colours = colours
+        scene.document.loaded.connect(self._loaded)
         if scene.document.model is not None:
-            self._update_legend()
+            self._loaded()
+
+    def _loaded(self) -> None:
+        """The backbone's layers and colours apply to a structure with a backbone only; one
+        without shows its atoms."""
+        editable = self.scene.document.editable
+        for layer in BACKBONE_LAYERS:
+            self.layer_boxes[layer].setEnabled(editable)
+        self.colours.setEnabled(editable)
+        if not editable:
+            self.layer_boxes[Layer.ATOMS].setChecked(True)
+        self._update_legend()
 
     def _colouring_changed(self) -> None:
         self.scene.set_colouring(self.colouring.currentData())

@@ -148,6 +148,10 @@ class ValidationPanel(QWidget):
         """Show the current report."""
         report, triaged = self.validation.report, self.validation.triaged
         if report is None:
+            for label in self.count_labels.values():
+                label.setText("")
+            self.timing.setText(self.validation.document.read_only_reason)
+            self.worst.clear()
             return
         counts = report.counts
         for kind, label in self.count_labels.items():

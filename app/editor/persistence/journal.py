@@ -142,7 +142,7 @@ class Journal(QObject):
         fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # held while this editor runs
         document = self.document
         os.write(self._fd, records.MAGIC + records.encode(records.header(document.path, document.kind.value,
-                                                                             document.source)))
+                                                                             document.source, document.model_number)))
         self._mirror = []
 
     def _write(self, *entries: records.Record) -> None:

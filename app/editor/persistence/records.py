@@ -7,7 +7,7 @@ bytes. Arrays are
 written as they are in memory, so coordinates come back bit for bit. A file cut off
 mid-record (a crash while writing) reads as the records before the damage.
 
-Kinds: ``header`` (format version, file name, ribbon kind, the file's bytes as read),
+Kinds: ``header`` (format version, file name, ribbon kind, model, the file's bytes as read),
 ``push`` (an undo step pushed at a stack position: its text and :class:`~core.protein.model.Edit`),
 ``index`` (the stack position after a step, undo or redo, the clean position, the file
 names, the level, segment and multiresolution switch), ``state`` (level, segment and
@@ -29,8 +29,9 @@ from core.protein.model import Edit
 
 MAGIC = b"\x89RWAVE\r\n"
 """The first bytes of a journal or session file."""
-VERSION = 1
-"""Format version written; files of a newer version are refused with a message."""
+VERSION = 2
+"""Format version written; files of a newer version are refused with a message. Version 2
+added the model of the header (version 1 files hold model 1)."""
 _FRAME = struct.Struct("<II")
 _EDIT_ARRAYS = ("old_points", "new_points", "residues", "rows", "old_coords", "new_coords")
 
@@ -97,10 +98,15 @@ def _record_at(data: bytes, offset: int) -> tuple[Record | None, int]:
     return Record(kind, meta, arrays), offset + _FRAME.size + length
 
 
-def header(path: Path, kind: str, source: bytes) -> Record:
-    """The first record: the file as read, its name and the ribbon kind."""
-    return Record("header", {"version": VERSION, "path": str(path), "kind": kind},
+def header(path: Path, kind: str, source: bytes, model: int) -> Record:
+    """The first record: the file as read, its name, the ribbon kind and the model (from 1) edited."""
+    return Record("header", {"version": VERSION, "path": str(path), "kind": kind, "model": model},
                   {"source": np.frombuffer(source, dtype=np.uint8)})
+
+
+def model_of(fields: dict) -> int:
+    """The model of a ``header`` record's fields (1 for files written before models were recorded)."""
+    return fields.get("model", 1)
 
 
 def push(at: int, text: str, edit: Edit) -> Record:

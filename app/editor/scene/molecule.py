@@ -99,7 +99,7 @@ def element_colours(elements: np.ndarray, carbon: RGB | None = None) -> np.ndarr
 
 def ca_rows(structure: Structure) -> np.ndarray:
     """Row of ``structure.coords`` holding the Cα of each backbone residue, (n_residues,)."""
-    ca = np.concatenate([s.ca for s in structure.segments])
+    ca = np.concatenate([np.empty((0, 3)), *(s.ca for s in structure.segments)])
     owner = structure.atom_residue
     candidates = np.flatnonzero(owner >= 0)
     match = candidates[np.all(structure.coords[candidates] == ca[owner[candidates]], axis=1)]

@@ -172,7 +172,8 @@ class Comparison(QObject):
     """The structures compared with a :class:`Document`'s current chain (a QObject without widgets).
 
     Follows the document: a new structure, ribbon kind or chain refits every compared
-    structure (keeping the previous fit where the new chain cannot be paired).
+    structure (keeping the previous fit where the new chain cannot be paired); a structure
+    without a backbone, which nothing can be superposed on, drops them.
     """
 
     changed = Signal()
@@ -210,8 +211,9 @@ class Comparison(QObject):
         Raises :class:`core.protein.structure.StructureError` (unreadable file) or ValueError (no such
         chain, no protein, too few residue pairs, no structure open).
         """
-        if self.document.model is None:
-            raise ValueError("open a structure before adding structures to compare with it")
+        if not self.document.editable:
+            raise ValueError(f"{self.document.read_only_reason or 'no structure is open'}: "
+                             "there is no chain to compare with")
         data = read_bytes(path) if data is None else data
         structure = read_structure(path, data)
         if not structure.segments:
@@ -267,6 +269,10 @@ class Comparison(QObject):
         return document.model.coords[document.ca_rows[rows]], segments
 
     def _refit_all(self) -> None:
+        if not self.document.editable:
+            self.items, self._chain = [], None
+            self.changed.emit()
+            return
         self._chain = self.document.structure.segments[self.document.segment].chain
         refitted = []
         for item in self.items:

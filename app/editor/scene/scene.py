@@ -5,7 +5,8 @@ Meshes are built when a structure is loaded (or the ribbon kind changes). After 
 rings, Cα balls and sticks, atom rows) straight into the VTK arrays; moving the slider
 rewrites the points of the level curves and control points; a change in the number of
 shown control points swaps the data of their small glyph mesh under the same actor.
-Nothing here changes the document.
+A structure that is only viewed (no backbone) gets the atom layers and a caption saying
+why. Nothing here changes the document.
 """
 
 from __future__ import annotations
@@ -138,14 +139,14 @@ class Scene(QObject):
     def set_colouring(self, colouring: Colouring | str) -> None:
         """Colour the tube and the Cα trace by secondary structure, residue type or chain."""
         self.colouring = Colouring(colouring)
-        if self.document.model is not None:
+        if self.document.editable:
             self._residue_colours_changed()
             self.plotter.render()
 
     def set_fat_helices(self, on: bool) -> None:
         """Tube radius by secondary structure (sheet > helix > other) or uniform."""
         self.fat_helices = on
-        if self.document.model is not None:
+        if self.document.editable:
             self._ring_radii = self._radii()
             for segment in range(len(self.document.paths)):
                 self._sweep(segment, slice(None))
@@ -160,8 +161,10 @@ class Scene(QObject):
             self.plotter.render()
 
     def reset_camera(self) -> None:
-        """Look at the structure along its axis of least extent (the widest view of the fold)."""
-        ca = self.document.model.coords[self.document.ca_rows]
+        """Look at the structure (its Cα, or all atoms without a backbone) along its axis of
+        least extent (the widest view of the fold)."""
+        coords = self.document.model.coords
+        ca = coords[self.document.ca_rows] if len(self.document.ca_rows) else coords
         centre = ca.mean(axis=0)
         _, axes = np.linalg.eigh((ca - centre).T @ (ca - centre))  # by increasing extent; any number of atoms
         renderer = self.plotter.renderer
@@ -201,18 +204,21 @@ class Scene(QObject):
         self.plotter.clear_actors()
         self.meshes.clear()
         self.actors.clear()
-        self._residue_offset = np.array([s.residue_index[0] for s in structure.segments])
-        self._residue_chain = np.concatenate([np.full(len(s), s.chain) for s in structure.segments])
-        self.others = Others.DIMMED if len(set(self._residue_chain)) > DIM_ABOVE_CHAINS else Others.SHOWN
-        self._concealed = False
-        self._build_tube()
-        self._build_curve()
-        self._build_ca_trace()
-        self._build_atoms()
         self._shown_points = np.empty(0, dtype=np.int64)
-        self._update_control_points()
-        self.meshes["selection"] = pv.PolyData()
-        self._on_selection(render=False)
+        self.others = Others.SHOWN
+        self._concealed = False
+        if self.document.editable:
+            self._residue_offset = np.array([s.residue_index[0] for s in structure.segments])
+            self._residue_chain = np.concatenate([np.full(len(s), s.chain) for s in structure.segments])
+            if len(set(self._residue_chain)) > DIM_ABOVE_CHAINS:
+                self.others = Others.DIMMED
+            self._build_tube()
+            self._build_curve()
+            self._build_ca_trace()
+            self._update_control_points()
+            self.meshes["selection"] = pv.PolyData()
+            self._on_selection(render=False)
+        self._build_atoms()
         self._show_layers()
         self._update_caption()
         if self.others is not Others.SHOWN:
@@ -481,9 +487,10 @@ class Scene(QObject):
 
     def _update_caption(self) -> None:
         document = self.document
-        text = (f"{document.structure.entry_id}   {document.segment_label(document.segment)}\n"
-                f"level {document.shown_level():.2f} of {document.max_level:.2f}   "
-                f"{document.level_curve().n_segments} curve segments")
+        text = document.read_only_reason or (
+            f"{document.structure.entry_id}   {document.segment_label(document.segment)}\n"
+            f"level {document.shown_level():.2f} of {document.max_level:.2f}   "
+            f"{document.level_curve().n_segments} curve segments")
         if "caption" in self.actors:
             self.actors["caption"].SetText(2, text)  # the upper-left corner of a corner annotation
         else:

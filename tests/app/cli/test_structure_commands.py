@@ -1,6 +1,7 @@
 """The headless commands ``info``, ``curve`` and ``edit`` on real entries, through ``main``."""
 
 import csv
+import gzip
 import io
 import json
 import math
@@ -140,6 +141,12 @@ def test_edit_never_overwrites_without_asking(capsys, tmp_path):
           "1,0,0", "-o", "x.pdb"], "has 1 segment"),
         (["edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "3", "--residue", "500", "--move", "1,0,0", "-o",
           "x.pdb"], "no residue 500"),
+        (["info", DATA / "1L2Y.pdb.gz", "--model", "39"], "no model 39; the file has 38 model"),
+        (["edit", DATA / "1LCD.cif.gz", "--model", "4", "--chain", "A", "--level", "3", "--point", "1", "--move",
+          "1,0,0", "-o", "x.pdb"], "no model 4; the file has 3 model"),
+        (["curve", DATA / "2BEG.pdb.gz", "--model", "2"], "no model 2; the file has 1 model"),
+        (["validate", DATA / "1L2Y.pdb.gz", "--model", "100"], "no model 100"),
+        (["surface", DATA / "1L2Y.pdb.gz", "--model", "40", "-o", "x.vtp"], "no model 40"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_status_1(capsys, tmp_path, monkeypatch, argv, message):
@@ -163,3 +170,55 @@ def test_usage_errors_exit_2(capsys):
               "-o", "x.pdb"])
     assert exit_info.value.code == 2
     assert "DX,DY,DZ" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("model", ["0", "-2", "1.5", "one"])
+def test_a_model_that_is_not_a_positive_whole_number_is_a_usage_error(capsys, model):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["info", str(DATA / "1L2Y.pdb.gz"), f"--model={model}"])
+    assert exit_info.value.code == 2 and "--model" in capsys.readouterr().err
+
+
+# ----------------------------------------------------------------------------- ensembles
+
+
+def test_info_says_which_model_of_how_many(capsys):
+    _, first, _ = run(capsys, "info", DATA / "1L2Y.pdb.gz")
+    _, seventh, _ = run(capsys, "info", DATA / "1L2Y.pdb.gz", "--model", "7")
+    _, single, _ = run(capsys, "info", DATA / "1UBQ.pdb.gz")
+    assert "model 1 of 38" in first and "model 7 of 38" in seventh and "; 1 model" in single
+    status, out, _ = run(capsys, "info", DATA / "1LCD.cif.gz", "--model", "3", "--json")
+    report = json.loads(out)
+    assert status == 0 and (report["model"], report["models"]) == (3, 3)
+    assert report["atoms"] == read_structure(DATA / "1LCD.cif.gz", model=3).n_atoms == 1122  # model 1 has 1137
+
+
+def test_curve_and_validate_read_the_model_asked(capsys):
+    model = read_structure(DATA / "1L2Y.pdb.gz", model=12)
+    _, out, _ = run(capsys, "curve", DATA / "1L2Y.pdb.gz", "--model", "12", "--csv")
+    ca = np.array([[float(r[f"ca_{a}"]) for a in "xyz"] for r in read_csv(out)])
+    np.testing.assert_allclose(ca, model.segments[0].ca, atol=5e-4)
+    assert not np.allclose(ca, read_structure(DATA / "1L2Y.pdb.gz").segments[0].ca, atol=0.1)
+    _, out, _ = run(capsys, "validate", DATA / "1LCD.cif.gz", "--model", "2", "--json")
+    assert json.loads(out)["model"] == 2
+    _, text, _ = run(capsys, "validate", DATA / "1LCD.cif.gz", "--model", "2")
+    assert text.startswith(f"{DATA / '1LCD.cif.gz'}: 1LCD model 2 of 3, ")
+
+
+@pytest.mark.parametrize(("name", "model", "suffix"), [("1L2Y.pdb.gz", 5, ".pdb"), ("1LCD.cif.gz", 2, ".cif")])
+def test_edit_of_one_model_leaves_every_other_model_as_read(capsys, tmp_path, name, model, suffix):
+    out = tmp_path / f"edited{suffix}"
+    status, printed, _ = run(capsys, "edit", DATA / name, "--model", str(model), "--chain", "A", "--level", "2",
+                             "--point", "2", "--move", "1.5,0,-1", "-o", out)
+    assert status == 0 and f"atoms of model {model}; wrote {out}" in printed
+    before, after = read_structure(DATA / name, model=model), read_structure(out, model=model)
+    moved = np.any(after.coords != before.coords, axis=1)
+    assert np.any(np.abs(after.coords - before.coords) > 0.5, axis=1).sum() > 100
+    for other in (1, model - 1, model + 1, before.n_models):
+        if other != model:
+            np.testing.assert_array_equal(read_structure(out, model=other).coords,
+                                          read_structure(DATA / name, model=other).coords)
+    original = gzip.decompress((DATA / name).read_bytes()).decode().splitlines()
+    written = out.read_text().splitlines()
+    assert len(written) == len(original)
+    assert sum(a != b for a, b in zip(written, original)) == moved.sum()  # the moved atoms' lines alone

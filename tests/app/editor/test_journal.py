@@ -38,7 +38,7 @@ def test_records_round_trip_bit_for_bit() -> None:
     rng = np.random.default_rng(3)
     arrays = {"coords": rng.normal(size=(17, 3)), "rows": np.arange(17, dtype=np.int64) * 3, "empty": np.zeros((0, 3))}
     record = records.Record("push", {"text": "Move point 3", "at": 2}, arrays)
-    (back,), damaged = records.decode(records.MAGIC + records.encode(records.header(Path("x.pdb"), "peptide", b"ab"))
+    (back,), damaged = records.decode(records.MAGIC + records.encode(records.header(Path("x.pdb"), "peptide", b"ab", 1))
                                       + records.encode(record))[0][1:], False
     assert back.kind == "push" and back.fields == record.fields and not damaged
     for name, array in arrays.items():

@@ -246,6 +246,7 @@ def test_compared_colours_are_distinct_from_every_editor_colour() -> None:
     from app.editor.scene import molecule, overlay, scene
 
     editor = [*molecule.SS_COLOURS.values(), scene.CURVE_COLOUR, scene.OTHER_CURVE_COLOUR, scene.POINT_COLOUR,
-              scene.PICKED_COLOUR, scene.POLYGON_COLOUR, scene.CA_STICK_COLOUR, (255, 255, 255), (223, 229, 236)]
+              scene.PICKED_COLOUR, scene.SELECTION_COLOUR, scene.POLYGON_COLOUR, scene.CA_STICK_COLOUR,
+              (255, 255, 255), (223, 229, 236)]
     distances = np.linalg.norm(np.array(overlay.PALETTE)[:, None] - np.array(editor)[None], axis=2)
     assert distances.min() >= 60
