@@ -211,7 +211,7 @@ class RamachandranPanel(QWidget):
         self._stale = False
         self._last = time.perf_counter()
         self.redraws += 1
-        points = self.points = segment_points(self.document) if self.document.model is not None else None
+        points = self.points = segment_points(self.document) if self.document.editable else None
         if points is None:
             empty = np.empty((0, 2))
             for collection in (*self.scatters, self.moved_rings, self.picked_rings):

@@ -61,7 +61,7 @@ class SequenceStrip(QWidget):
 
     def _count(self) -> int:
         document = self.document
-        return len(document.structure.segments[document.segment]) if document.model is not None else 0
+        return len(document.structure.segments[document.segment]) if document.editable else 0
 
     def _refresh(self) -> None:
         self.setMinimumSize(self.sizeHint())
@@ -70,7 +70,7 @@ class SequenceStrip(QWidget):
 
     def paintEvent(self, event: QPaintEvent) -> None:
         document = self.document
-        if document.model is None:
+        if not document.editable:
             return
         segment = document.structure.segments[document.segment]
         start = int(segment.residue_index[0])
@@ -141,7 +141,7 @@ class SequenceBar(QScrollArea):
     def _follow(self) -> None:
         """Scroll so the first selected (or picked) residue of the segment is visible."""
         document = self.strip.document
-        if document.model is None:
+        if not document.editable:
             return
         segment = document.structure.segments[document.segment]
         start = int(segment.residue_index[0])

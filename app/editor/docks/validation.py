@@ -151,7 +151,9 @@ class ValidationPanel(QWidget):
             for label in self.count_labels.values():
                 label.setText("")
             self.timing.setText(self.validation.document.read_only_reason)
-            self.worst.clear()
+            self.offenders.clear()
+            self.listed = ()
+            self.shown.setText("")
             return
         counts = report.counts
         for kind, label in self.count_labels.items():
@@ -178,6 +180,8 @@ class ValidationPanel(QWidget):
 
     def _fill_list(self) -> None:
         triaged = self.validation.triaged
+        if triaged is None:
+            return
         self.listed = triaged.flags[:LISTED]
         items = []
         for flag, novelty in zip(self.listed, triaged.novelty):

@@ -31,9 +31,11 @@ FAT_RADII = {"H": 1.5, "E": 1.8, "C": 0.45}
 CA_RADIUS = 0.45
 LIGAND_ATOM_RADIUS = 0.35
 ION_RADIUS = 1.1
-POINT_SPACING_FRACTION = 0.08
+POINT_SPACING_FRACTION = 0.04
 """Control-point spheres have this fraction of the level's median control-point spacing as
-radius (at least HANDLE_RADIUS)..."""
+radius (at least HANDLE_RADIUS, at most MAX_POINT_RADIUS)..."""
+MAX_POINT_RADIUS = 2.0
+"""Å: coarse control polygons are wide (30 Å between points on ubiquitin at level 4)."""
 MIN_POINT_PIXELS = 6.0
 """... and never less than this on screen (pixels), however far the camera is."""
 
@@ -448,7 +450,7 @@ class Scene(QObject):
         else:
             depth = float((points.mean(axis=0) - np.array(camera.GetPosition())) @ camera.GetDirectionOfProjection())
             pixel = 2.0 * np.tan(np.radians(camera.GetViewAngle()) / 2.0) * max(depth, 0.0) / height
-        radius = max(HANDLE_RADIUS, POINT_SPACING_FRACTION * spacing, MIN_POINT_PIXELS * pixel)
+        radius = max(HANDLE_RADIUS, min(POINT_SPACING_FRACTION * spacing, MAX_POINT_RADIUS), MIN_POINT_PIXELS * pixel)
         if abs(radius - self.point_radius) > 0.05 * self.point_radius:
             self.point_radius = radius
             self._update_control_points(resized=True)
