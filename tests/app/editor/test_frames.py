@@ -1,0 +1,73 @@
+"""One frame per event (#18): a slider step, a pick, a drag step, an undo and a zoom each draw
+the view once, however many views change; a screenshot shows the current state at once."""
+
+from pathlib import Path
+
+import numpy as np
+from PySide6.QtCore import QPoint, QPointF, Qt
+from PySide6.QtGui import QWheelEvent
+from PySide6.QtWidgets import QApplication
+from pytestqt.qtbot import QtBot
+
+from app.editor.document import Document
+from app.editor.main_window import MainWindow
+from app.editor.scene.scene import Layer
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+
+
+def _frames_of(qtbot: QtBot, window: MainWindow, send) -> int:  # noqa: ANN001 (a callable)
+    """Frames the view draws for the event ``send`` sends (the event loop run until idle)."""
+    qtbot.wait(150)  # nothing pending from before (the deferred validation check included)
+    before = window.plotter.frames
+    send()
+    qtbot.wait(150)
+    return window.plotter.frames - before
+
+
+def test_each_event_draws_one_frame(qtbot: QtBot) -> None:
+    document = Document()
+    document.open(DATA / "1AYE.pdb.gz")
+    window = MainWindow(document)
+    qtbot.addWidget(window)
+    window.show()
+    qtbot.waitExposed(window)
+    window.scene.set_layer(Layer.CA_TRACE, True)  # more views to change
+    view = window.plotter
+    slider = window.dimension_panel.slider
+    assert _frames_of(qtbot, window, lambda: qtbot.keyClick(slider, Qt.Key.Key_Right)) == 1
+
+    index = int(window.scene.shown_control_points()[4])
+    renderer = view.renderer
+    renderer.SetWorldPoint(*document.level_curve().control_points[index], 1.0)
+    renderer.WorldToDisplay()
+    x, y, _ = renderer.GetDisplayPoint()
+    at = QPoint(round(x / view.devicePixelRatioF()), round(view.height() - 1 - y / view.devicePixelRatioF()))
+    assert _frames_of(qtbot, window, lambda: qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=at)) == 1
+    assert document.pick is not None and document.pick.index == index
+    window.scene.set_layer(Layer.VALIDATION, False)  # shown, its markers draw once more after each deferred check
+    assert _frames_of(qtbot, window, lambda: qtbot.mouseMove(view, at + QPoint(30, 20))) == 1
+    assert _frames_of(qtbot, window, lambda: qtbot.mouseRelease(view, Qt.MouseButton.LeftButton,
+                                                                pos=at + QPoint(30, 20))) == 1
+    assert document.undo_stack.count() == 1
+    assert _frames_of(qtbot, window, window.undo_action.trigger) == 1
+
+    centre = QPointF(view.width() / 2, view.height() / 2)
+    wheel = QWheelEvent(centre, view.mapToGlobal(centre), QPoint(), QPoint(0, 120), Qt.MouseButton.NoButton,
+                        Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase, False)
+    distance = view.camera.distance
+    assert _frames_of(qtbot, window, lambda: QApplication.sendEvent(view, wheel)) == 1
+    assert view.camera.distance < distance
+
+
+def test_a_screenshot_shows_a_change_not_drawn_yet(qtbot: QtBot) -> None:
+    document = Document()
+    document.open(DATA / "1UBQ.pdb.gz")
+    window = MainWindow(document)
+    qtbot.addWidget(window)
+    window.show()
+    qtbot.waitExposed(window)
+    before = window.plotter.screenshot(return_img=True).astype(int)
+    window.scene.set_layer(Layer.TUBE, False)  # asks for a frame; none is drawn before the loop turns
+    after = window.plotter.screenshot(return_img=True).astype(int)
+    assert np.count_nonzero(np.abs(after - before).sum(axis=2) > 30) > 5000
