@@ -59,3 +59,10 @@ print(json.dumps([status, sorted(loaded & set({GUI_PACKAGES!r}))]))
     )
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout) == [0, []]
+
+
+def test_test_modules_have_unique_names() -> None:
+    """pytest imports test modules by their base name (the tests have no packages): two files
+    of one name in different folders stop the whole run at collection."""
+    names = [path.name for path in (ROOT / "tests").rglob("test_*.py")]
+    assert sorted(name for name in set(names) if names.count(name) > 1) == []

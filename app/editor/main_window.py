@@ -35,6 +35,7 @@ from PySide6.QtWidgets import (
     QLabel,
     QLineEdit,
     QMainWindow,
+    QMenu,
     QMessageBox,
     QScrollArea,
     QStyle,
@@ -45,6 +46,7 @@ from PySide6.QtWidgets import (
 )
 
 from app import EXAMPLES_DIR
+from app.editor import help
 from app.editor.docks.comparison import ComparisonPanel
 from app.editor.docks.console import PythonConsole
 from app.editor.docks.panels import DisplayPanel, RibbonDimensionPanel
@@ -478,6 +480,10 @@ class MainWindow(QMainWindow):
         console = self.console_dock.toggleViewAction()
         console.setShortcut(QKeySequence("Ctrl+Shift+P"))
         view_menu.addAction(console)
+        help_menu = menu.addMenu("&Help")
+        help_menu.addAction(self._action("&Mouse and Keyboard", QKeySequence.StandardKey.HelpContents,
+                                         self.show_reference))
+        help_menu.addAction(self._action(f"&About {APP_NAME}", QKeySequence(), self.show_about))
         toolbar = self.addToolBar("Main")
         toolbar.setObjectName("Main")
         toolbar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
@@ -662,6 +668,24 @@ class MainWindow(QMainWindow):
 
     def _update_regularize_action(self) -> None:
         self.regularize_action.setEnabled(self.document.pick is not None)
+
+    def show_reference(self) -> QMessageBox:
+        """Help ▸ Mouse and Keyboard: the gestures and the keys bound (a window-modal box)."""
+        menus = [action for menu in self.menuBar().findChildren(QMenu) for action in menu.actions()]
+        return self._message("Mouse and keyboard", help.reference_html(list(dict.fromkeys(menus + self.actions()))))
+
+    def show_about(self) -> QMessageBox:
+        """Help ▸ About: what ribbonwave is and the versions of what it runs on."""
+        return self._message(f"About {APP_NAME}", "<p><b>ribbonwave</b>: multiresolution (wavelet) analysis and "
+                             "editing of protein structures, after M. Carson, <i>Wavelets and molecular structure</i> "
+                             "(1996).</p><pre>" + help.about_text() + "</pre>")
+
+    def _message(self, title: str, html: str) -> QMessageBox:
+        box = QMessageBox(QMessageBox.Icon.NoIcon, title, html, QMessageBox.StandardButton.Close, self)
+        box.setTextFormat(Qt.TextFormat.RichText)
+        box.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
+        box.open()  # not blocking: the editor goes on behind it
+        return box
 
     def _focus_go_to(self) -> None:
         self.go_to_field.setFocus()

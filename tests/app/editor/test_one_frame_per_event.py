@@ -71,3 +71,23 @@ def test_a_screenshot_shows_a_change_not_drawn_yet(qtbot: QtBot) -> None:
     window.scene.set_layer(Layer.TUBE, False)  # asks for a frame; none is drawn before the loop turns
     after = window.plotter.screenshot(return_img=True).astype(int)
     assert np.count_nonzero(np.abs(after - before).sum(axis=2) > 30) > 5000
+
+
+def test_help_names_the_keys_bound_and_the_versions(qtbot: QtBot) -> None:
+    """Help ▸ Mouse and Keyboard lists the window's own shortcuts; About gives the versions (#18)."""
+    import gemmi
+    import vtkmodules.vtkCommonCore as vtk
+    from PySide6.QtCore import qVersion
+
+    window = MainWindow()
+    qtbot.addWidget(window)
+    window.show()
+    reference = window.show_reference()
+    assert reference.isVisible()
+    assert "Go to Residue" in reference.text() and "Ctrl+L" in reference.text() and "Ctrl+Y" in reference.text()
+    assert "Double click" in reference.text()
+    reference.close()
+    about = window.show_about()
+    for part in (f"Qt {qVersion()}", f"VTK {vtk.vtkVersion.GetVTKVersion()}", f"gemmi {gemmi.__version__}"):
+        assert part in about.text()
+    about.close()

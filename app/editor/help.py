@@ -1,0 +1,48 @@
+"""The Help menu's texts: the mouse and keyboard reference and About with the versions in use.
+
+The keyboard table is read from the window's actions, so it always names the keys bound.
+"""
+
+from __future__ import annotations
+
+import platform
+from importlib.metadata import version
+
+from PySide6.QtCore import qVersion
+from PySide6.QtGui import QAction, QKeySequence
+
+MOUSE = (
+    ("Drag a control point", "move it in the plane facing you (one undo step)"),
+    ("Drag a face of the handle box", "move the picked point in that face's plane"),
+    ("Shift while dragging", "keep to the one axis the pointer moves most along"),
+    ("Click a control point", "pick it: the status bar names the residues it moves"),
+    ("Click a residue", "select it; on another chain, edit that chain"),
+    ("Double click", "centre the view on what is under the pointer"),
+    ("Drag elsewhere", "turn the view; wheel: zoom"),
+    ("Point at anything", "name it in a tooltip and the status bar"),
+    ("Sequence bar: click, drag, Shift+click", "select residues and centre on them"),
+)
+
+
+def reference_html(actions: list[QAction]) -> str:
+    """An HTML table of the mouse gestures and of the keys bound to ``actions``."""
+    rows = [f"<tr><td><b>{gesture}</b></td><td>{effect}</td></tr>" for gesture, effect in MOUSE]
+    keys = []
+    for action in actions:
+        shortcuts = [s.toString(QKeySequence.SequenceFormat.NativeText) for s in action.shortcuts() if not s.isEmpty()]
+        if shortcuts:
+            name = action.text().replace("&", "").rstrip("…")
+            keys.append(f"<tr><td><b>{' or '.join(shortcuts)}</b></td><td>{name}</td></tr>")
+    return (f"<h3>Mouse</h3><table cellspacing='4'>{''.join(rows)}</table>"
+            f"<h3>Keyboard</h3><table cellspacing='4'>{''.join(keys)}</table>")
+
+
+def about_text() -> str:
+    """One line per component: ribbonwave, Python, Qt, VTK, pyvista, gemmi, numpy, scipy."""
+    from vtkmodules.vtkCommonCore import vtkVersion
+
+    versions = {"ribbonwave": version("ribbonwave"), "Python": platform.python_version(), "Qt": qVersion(),
+                "PySide6": version("PySide6-Essentials"), "VTK": vtkVersion.GetVTKVersion(),
+                "pyvista": version("pyvista"), "gemmi": version("gemmi"), "numpy": version("numpy"),
+                "scipy": version("scipy")}
+    return "\n".join(f"{name} {value}" for name, value in versions.items())
