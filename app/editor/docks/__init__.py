@@ -1,2 +1,2 @@
-"""The dock panels of the editor window: ribbon dimension and display, compared structures,
-surfaces and validation."""
+"""The dock panels of the editor window: ribbon dimension and display, the sequence bar,
+compared structures, surfaces, validation, the Ramachandran plot and the Python console."""
