@@ -80,12 +80,9 @@ def describe(document: Document, hit: Hit) -> str:
         table = structure.atoms
         k = hit.index
         return f"{table.chain[k]}:{table.resname[k]}{table.resseq[k]} {table.name[k]} ({table.element[k]})"
-    segment = document.segment_of(hit.row)
-    local = hit.row - int(structure.segments[segment].residue_index[0])
-    name = structure.segments[segment].labels[local]
-    if hit.kind == "atom":
-        name += f" {structure.atoms.name[hit.index]}"
-    return f"{name} · {SS_NAMES[structure.segments[segment].ss[local]]}"
+    segment = structure.segments[document.segment_of(hit.row)]
+    name = document.row_label(hit.row) + (f" {structure.atoms.name[hit.index]}" if hit.kind == "atom" else "")
+    return f"{name} · {SS_NAMES[segment.ss[hit.row - int(segment.residue_index[0])]]}"
 
 
 def _front_hit(event: PointerEvent, points: np.ndarray, radius: float, allowed: np.ndarray | None = None) -> int | None:

@@ -111,7 +111,7 @@ class MainWindow(QMainWindow):
         self.controller = DragController(self.document)
         self.pointer = PointerAdapter(self.plotter, self._on_pointer)
         self._press_at: tuple[int, int] | None = None  # where a press the camera took began (display pixels)
-        self._hovered: str | None = None
+        self._hovered: tuple | None = None  # what the hover names now
 
         self.dimension_panel = RibbonDimensionPanel(self.document)
         self.display_panel = DisplayPanel(self.scene)
@@ -357,14 +357,8 @@ class MainWindow(QMainWindow):
         return image
 
     def show_flag(self, flag: Flag) -> None:
-        """Centre the view on ``flag``'s marker and select its residues; where they lie in one
-        backbone segment, that segment becomes the edited one."""
-        segments = {self.document.segment_of(row) for row in flag.residues}
-        if len(segments) == 1:
-            self.document.set_segment(segments.pop())  # frames the segment: centre afterwards
-        self.document.select(list(flag.residues))
-        self.scene.centre_on(np.array(flag.position))
-        self.plotter.render()
+        """Centre the view on ``flag``'s marker and select its residues (see :meth:`select_and_centre`)."""
+        self.select_and_centre(np.array(flag.residues, dtype=np.int64), np.array(flag.position))
 
     # ------------------------------------------------------------------ events
 
@@ -587,26 +581,22 @@ class MainWindow(QMainWindow):
     def _hover(self, event: PointerEvent) -> None:
         """Name what is under the pointer in a tooltip and the status bar (when it changes)."""
         hit = self._hit(event) if self.document.model is not None else None
-        text = None if hit is None else describe(self.document, hit)
-        if text == self._hovered:
+        key = None if hit is None else (hit.kind, hit.index, hit.row, self.document.shown_level())
+        if key == self._hovered:  # the same thing: no new name (a point's costs an edit plan)
             return
-        self._hovered = text
-        self.status_labels["hover"].setText(text or "")
-        if text is None:
+        self._hovered = key
+        text = "" if hit is None else describe(self.document, hit)
+        self.status_labels["hover"].setText(text)
+        if hit is None:
             QToolTip.hideText()
         else:
             QToolTip.showText(QCursor.pos(), text, self.plotter)
 
     def _click(self, event: PointerEvent) -> None:
-        """A click that no drag took: select the residue under the pointer; one of another
-        chain also becomes the edited segment (framed)."""
+        """A click that no drag took: select the residue under the pointer (see :meth:`_select`)."""
         hit = self._hit(event)
-        if hit is None or hit.row < 0 or hit.kind == "point":
-            return
-        segment = self.document.segment_of(hit.row)
-        if segment != self.document.segment:
-            self.document.set_segment(segment)
-        self.document.select([hit.row])
+        if hit is not None and hit.row >= 0 and hit.kind != "point":
+            self._select([hit.row])
 
     def _centre_on_pointer(self, event: PointerEvent) -> None:
         """Double click: turn the view about what is under the pointer (and select its residue)."""
@@ -614,22 +604,28 @@ class MainWindow(QMainWindow):
         if hit is None:
             return
         if hit.row >= 0 and hit.kind != "point":
-            self.document.select([hit.row])
+            self._select([hit.row])
         self.scene.centre_on(hit.position)
         self.plotter.render()
 
-    def select_and_centre(self, rows: np.ndarray) -> None:
-        """Select residues ``rows`` (residue-table rows), make their segment the edited one and
-        centre the view on them."""
+    def select_and_centre(self, rows: np.ndarray, point: np.ndarray | None = None) -> None:
+        """Select residues ``rows`` (residue-table rows; see :meth:`_select`) and centre the view
+        on ``point`` (Å; default: their Cα's mean)."""
         rows = np.asarray(rows, dtype=np.int64)
-        if not len(rows):
+        if point is None and not len(rows):
             return
-        segment = self.document.segment_of(int(rows[0]))
-        if segment != self.document.segment:
-            self.document.set_segment(segment)
-        self.document.select(rows)
-        self.scene.centre_on(self.document.model.coords[self.document.ca_rows[rows]].mean(axis=0))
+        self._select(rows)
+        self.scene.centre_on(self.document.model.coords[self.document.ca_rows[rows]].mean(axis=0)
+                             if point is None else point)
         self.plotter.render()
+
+    def _select(self, rows: np.ndarray | list[int]) -> None:
+        """Select residues ``rows``; where they lie in one segment, that segment becomes the
+        edited one (framed: centre afterwards)."""
+        segments = {self.document.segment_of(int(row)) for row in rows}
+        if len(segments) == 1:
+            self.document.set_segment(segments.pop())
+        self.document.select(rows)
 
     def go_to(self, text: str) -> np.ndarray:
         """Select and centre on the residues named by ``text`` (``A:45``, ``45`` in the edited

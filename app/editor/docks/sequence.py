@@ -39,8 +39,7 @@ class SequenceStrip(QWidget):
         self.row_height = metrics.height() + 4
         self.setMouseTracking(True)
         self._anchor: int | None = None
-        for signal in (document.loaded, document.segmentChanged, document.picked, document.selectionChanged,
-                       document.levelChanged):
+        for signal in (document.loaded, document.segmentChanged, document.picked, document.selectionChanged):
             signal.connect(self._refresh)
         self._refresh()
 

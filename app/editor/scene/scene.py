@@ -158,7 +158,7 @@ class Scene(QObject):
     def set_others(self, others: Others | str) -> None:
         """Show, dim or hide the chains other than the edited segment's."""
         self.others = Others(others)
-        if self.document.model is not None:
+        if self.document.editable:
             self._draw_others()
             self.plotter.render()
 
@@ -185,9 +185,9 @@ class Scene(QObject):
         """Turn the view about ``point`` (Å) from now on and bring it to the centre of the view:
         the camera keeps its direction and distance."""
         camera = self.plotter.renderer.GetActiveCamera()
-        offset = np.asarray(point, dtype=float) - np.array(camera.GetFocalPoint())
-        camera.SetFocalPoint(*(np.array(camera.GetFocalPoint()) + offset))
-        camera.SetPosition(*(np.array(camera.GetPosition()) + offset))
+        point = np.asarray(point, dtype=float)
+        camera.SetPosition(*(np.array(camera.GetPosition()) + point - camera.GetFocalPoint()))
+        camera.SetFocalPoint(*point)
         self.plotter.renderer.ResetCameraClippingRange()
 
     def shown_atoms(self) -> np.ndarray:

@@ -3,7 +3,7 @@ clicks on other chains, the sequence bar, control points sized for big assemblie
 handle box's faces and Shift, other chains dimmed or hidden. Real Qt and VTK events in a
 window under Xvfb."""
 
-from pathlib import Path
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -11,28 +11,17 @@ from PySide6.QtCore import QPoint, Qt
 from PySide6.QtWidgets import QToolTip
 from pytestqt.qtbot import QtBot
 
-from app.editor.document import Document
 from app.editor.drag import HANDLE_BOX, HANDLE_RADIUS
 from app.editor.main_window import MainWindow
 from app.editor.scene.scene import MIN_POINT_PIXELS, TUBE_SIDES, Layer, Others
 
-DATA = Path(__file__).resolve().parents[2] / "data"
-
-
-def _window(qtbot: QtBot, name: str) -> MainWindow:
-    document = Document()
-    document.open(DATA / name)
-    window = MainWindow(document)
-    qtbot.addWidget(window)
-    window.show()
-    qtbot.waitExposed(window)
-    window.plotter.render()
-    return window
+Opener = Callable[[str], MainWindow]
+"""The ``open_window`` fixture: a shown window on a file of tests/data."""
 
 
 @pytest.fixture
-def window(qtbot: QtBot) -> MainWindow:
-    return _window(qtbot, "1UBQ.pdb.gz")
+def window(open_window: Opener) -> MainWindow:
+    return open_window("1UBQ.pdb.gz")
 
 
 def _display(window: MainWindow, point: np.ndarray) -> tuple[int, int]:
@@ -142,8 +131,8 @@ def test_go_to_residue_by_keyboard(window: MainWindow, qtbot: QtBot) -> None:
     assert len(window.document.selection) == 0
 
 
-def test_go_to_another_chain_makes_it_the_edited_segment(qtbot: QtBot) -> None:
-    window = _window(qtbot, "4HHB.pdb.gz")
+def test_go_to_another_chain_makes_it_the_edited_segment(open_window: Opener) -> None:
+    window = open_window("4HHB.pdb.gz")
     rows = window.go_to("C:87")
     document = window.document
     assert document.structure.segments[document.segment].chain == "C"
@@ -162,9 +151,9 @@ def test_double_click_centres_on_what_is_under_the_pointer(window: MainWindow, q
     assert window.document.undo_stack.count() == 0
 
 
-def test_a_click_on_another_chain_edits_that_chain(qtbot: QtBot) -> None:
+def test_a_click_on_another_chain_edits_that_chain(open_window: Opener, qtbot: QtBot) -> None:
     """4HHB: a click (no motion) on chain B's tube makes it the edited segment and frames it."""
-    window = _window(qtbot, "4HHB.pdb.gz")
+    window = open_window("4HHB.pdb.gz")
     document = window.document
     window.scene.set_layer(Layer.CONTROL_POINTS, False)
     segment_b = next(k for k, s in enumerate(document.structure.segments) if s.chain == "B")
@@ -209,8 +198,8 @@ def test_sequence_bar_selects_centres_and_marks_the_pick(window: MainWindow, qtb
     assert underline[0] == "#00aaff" and underline[1] != "#00aaff"
 
 
-def test_sequence_bar_follows_the_edited_segment(qtbot: QtBot) -> None:
-    window = _window(qtbot, "4HHB.pdb.gz")
+def test_sequence_bar_follows_the_edited_segment(open_window: Opener, qtbot: QtBot) -> None:
+    window = open_window("4HHB.pdb.gz")
     strip = window.sequence_bar.strip
     window.document.set_segment(1)
     assert strip.width() >= len(window.document.structure.segments[1]) * strip.cell
@@ -221,8 +210,8 @@ def test_sequence_bar_follows_the_edited_segment(qtbot: QtBot) -> None:
 # ------------------------------------------------------------------ big assemblies
 
 
-def test_control_points_keep_a_size_on_screen(qtbot: QtBot) -> None:
-    window = _window(qtbot, "4YVS.cif.gz")
+def test_control_points_keep_a_size_on_screen(open_window: Opener, qtbot: QtBot) -> None:
+    window = open_window("4YVS.cif.gz")
     scene = window.scene
     camera = window.plotter.camera
     height = window.plotter.renderer.GetSize()[1]
@@ -285,8 +274,8 @@ def test_handle_box_faces_move_in_their_plane_and_shift_keeps_one_axis(window: M
     assert np.count_nonzero(np.abs(moved) > 1e-6) == 1 and abs(moved[axis]) < 1e-6  # one axis of that plane
 
 
-def test_other_chains_dimmed_hidden_and_shown(qtbot: QtBot) -> None:
-    window = _window(qtbot, "4YVS.cif.gz")
+def test_other_chains_dimmed_hidden_and_shown(open_window: Opener) -> None:
+    window = open_window("4YVS.cif.gz")
     scene = window.scene
     assert scene.others is Others.DIMMED and Others(window.display_panel.others.currentData()) is Others.DIMMED
     document = window.document
@@ -310,17 +299,17 @@ def test_other_chains_dimmed_hidden_and_shown(qtbot: QtBot) -> None:
     assert np.array_equal(np.array(tube.point_data["colours"])[edited], colours[edited])  # in full colour
 
 
-def test_small_entries_open_with_every_chain_shown(qtbot: QtBot) -> None:
-    window = _window(qtbot, "4HHB.pdb.gz")
+def test_small_entries_open_with_every_chain_shown(open_window: Opener) -> None:
+    window = open_window("4HHB.pdb.gz")
     assert window.scene.others is Others.SHOWN
 
 
-def test_the_docks_fit_a_laptop_screen_without_scrolling(qtbot: QtBot) -> None:
+def test_the_docks_fit_a_laptop_screen_without_scrolling(open_window: Opener, qtbot: QtBot) -> None:
     """1366 x 768 (less a panel): the level controls, the display options, the validation list
     and the Ramachandran plot each show whole in their place."""
     from PySide6.QtWidgets import QDockWidget, QScrollArea
 
-    window = _window(qtbot, "4HHB.pdb.gz")
+    window = open_window("4HHB.pdb.gz")
     window.resize(1366, 728)
     qtbot.wait(50)
     docks = {dock.windowTitle(): dock for dock in window.findChildren(QDockWidget)}

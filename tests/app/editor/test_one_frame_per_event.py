@@ -1,7 +1,7 @@
 """One frame per event (#18): a slider step, a pick, a drag step, an undo and a zoom each draw
 the view once, however many views change; a screenshot shows the current state at once."""
 
-from pathlib import Path
+from collections.abc import Callable
 
 import numpy as np
 from PySide6.QtCore import QPoint, QPointF, Qt
@@ -9,11 +9,11 @@ from PySide6.QtGui import QWheelEvent
 from PySide6.QtWidgets import QApplication
 from pytestqt.qtbot import QtBot
 
-from app.editor.document import Document
 from app.editor.main_window import MainWindow
 from app.editor.scene.scene import Layer
 
-DATA = Path(__file__).resolve().parents[2] / "data"
+Opener = Callable[[str], MainWindow]
+"""The ``open_window`` fixture: a shown window on a file of tests/data."""
 
 
 def _frames_of(qtbot: QtBot, window: MainWindow, send) -> int:  # noqa: ANN001 (a callable)
@@ -25,13 +25,9 @@ def _frames_of(qtbot: QtBot, window: MainWindow, send) -> int:  # noqa: ANN001 (
     return window.plotter.frames - before
 
 
-def test_each_event_draws_one_frame(qtbot: QtBot) -> None:
-    document = Document()
-    document.open(DATA / "1AYE.pdb.gz")
-    window = MainWindow(document)
-    qtbot.addWidget(window)
-    window.show()
-    qtbot.waitExposed(window)
+def test_each_event_draws_one_frame(qtbot: QtBot, open_window: Opener) -> None:
+    window = open_window("1AYE.pdb.gz")
+    document = window.document
     window.scene.set_layer(Layer.CA_TRACE, True)  # more views to change
     view = window.plotter
     slider = window.dimension_panel.slider
@@ -60,13 +56,8 @@ def test_each_event_draws_one_frame(qtbot: QtBot) -> None:
     assert view.camera.distance < distance
 
 
-def test_a_screenshot_shows_a_change_not_drawn_yet(qtbot: QtBot) -> None:
-    document = Document()
-    document.open(DATA / "1UBQ.pdb.gz")
-    window = MainWindow(document)
-    qtbot.addWidget(window)
-    window.show()
-    qtbot.waitExposed(window)
+def test_a_screenshot_shows_a_change_not_drawn_yet(open_window: Opener) -> None:
+    window = open_window("1UBQ.pdb.gz")
     before = window.plotter.screenshot(return_img=True).astype(int)
     window.scene.set_layer(Layer.TUBE, False)  # asks for a frame; none is drawn before the loop turns
     after = window.plotter.screenshot(return_img=True).astype(int)
