@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 import os
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np

@@ -103,7 +103,6 @@ class MainWindow(QMainWindow):
         self.plotter.iren.clear_key_event_callbacks()  # no pyvista key bindings ('q' would close the view)
         self._swallow_style_keys()
         self.plotter.enable_anti_aliasing("fxaa")
-        self._smooth_still_frames_only()
         self.setCentralWidget(self.plotter)
         self.validation = LiveValidation(self.document)  # before the scene: its report is new when the scene renders
         self.scene = Scene(self.document, self.plotter)
@@ -114,6 +113,7 @@ class MainWindow(QMainWindow):
         self._hovered: tuple | None = None  # what the hover names now
 
         self.dimension_panel = RibbonDimensionPanel(self.document)
+        self._less_detail_while_moving()
         self.display_panel = DisplayPanel(self.scene)
         self.comparison = Comparison(self.document)  # after the scene: it redraws once the scene is rebuilt
         self.comparison_view = ComparisonView(self.comparison, self.plotter)
@@ -258,7 +258,6 @@ class MainWindow(QMainWindow):
         atomically; an existing file only with ``overwrite`` (else FileExistsError)."""
         size = None if width is None and height is None else (width or self.plotter.width(),
                                                                height or self.plotter.height())
-        self.plotter.renderer.SetUseFXAA(True)
         write_png(_image(self.plotter.screenshot(return_img=True, window_size=size)), Path(path), overwrite=overwrite)
         return Path(path)
 
@@ -529,16 +528,17 @@ class MainWindow(QMainWindow):
         interactor = self.plotter.iren.interactor
         tag = interactor.AddObserver("CharEvent", lambda caller, _: caller.GetCommand(tag).SetAbortFlag(1), PRIORITY)
 
-    def _smooth_still_frames_only(self) -> None:
-        """Anti-alias the frames drawn at rest, not those drawn while the camera turns (it costs
-        half of a frame with software OpenGL); drags do the same in :meth:`_on_pointer`."""
+    def _less_detail_while_moving(self) -> None:
+        """The scene draws less while the camera turns or zooms and while the level slides
+        (drags tell it in :meth:`_on_pointer`): frames at rest are drawn in full."""
         style = self.plotter.iren.interactor.GetInteractorStyle()
-        style.AddObserver("StartInteractionEvent", lambda *_: self.plotter.renderer.SetUseFXAA(False))
+        for event in ("StartInteractionEvent", "InteractionEvent"):
+            style.AddObserver(event, lambda *_: self.scene.moved())
         style.AddObserver("EndInteractionEvent", lambda *_: self._end_interaction())
+        self.dimension_panel.slider.valueChanged.connect(self.scene.moved)
 
     def _end_interaction(self) -> None:
         """The camera's gesture ended; one that moved less than a click's pixels was a click."""
-        self.plotter.renderer.SetUseFXAA(True)
         x, y = self.plotter.iren.interactor.GetEventPosition()
         press, self._press_at = self._press_at, None
         if press is not None and max(abs(x - press[0]), abs(y - press[1])) < CLICK_PIXELS:
@@ -559,18 +559,19 @@ class MainWindow(QMainWindow):
         if event.kind == "press" and grabs not in self.scene.layers:
             used = False  # what is hidden cannot be grabbed: the press turns the camera
         elif event.kind == "release" and self.controller.dragging:
-            self.plotter.renderer.SetUseFXAA(True)  # the frame after the drag is a still one
             with _busy():  # the release regularizes: a hard edit takes a few tenths of a second
-                return self.controller.handle(event)
+                used = self.controller.handle(event)
+            self.scene.moved()  # full detail a moment after the release
+            return used
         else:
             self.controller.point_radius = self.scene.point_radius  # as drawn
             used = self.controller.handle(event)
+            if used:
+                self.scene.moved()
         if event.kind == "press":
             # a press the camera takes: its release ends the camera's interaction (the camera
             # style holds the interactor's focus until then, so no release comes here)
             self._press_at = None if used else self.plotter.iren.interactor.GetEventPosition()
-            if used:
-                self.plotter.renderer.SetUseFXAA(False)
         return used
 
     def _hit(self, event: PointerEvent) -> Hit | None:

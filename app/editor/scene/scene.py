@@ -15,17 +15,25 @@ from enum import StrEnum
 
 import numpy as np
 import pyvista as pv
-from PySide6.QtCore import QObject
+from PySide6.QtCore import QObject, QTimer
 from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkRenderingCore import vtkTextActor
 
 from app.editor.document import Change, Document, Pick
 from app.editor.drag import HANDLE_BOX, HANDLE_RADIUS
 from app.editor.scene import molecule, tube
 from app.editor.scene.molecule import Colouring
+from app.editor.scene.view import View
 
 TUBE_SIDES = 12
 TUBE_RADIUS = 0.55
 """Å, the tube of the full-resolution ribbon."""
+MOVING_RING_STEP = 3
+MOVING_SIDE_STEP = 2
+"""While something moves, the tube of the segments not edited keeps every third ring and
+every other side of its vertices: a sixth of them."""
+STILL_AFTER_MS = 250
+"""Full detail comes back once nothing has moved for this long."""
 FAT_RADII = {"H": 1.5, "E": 1.8, "C": 0.45}
 """Å, tube radii by secondary structure with "fat helices" on (sheet > helix > other)."""
 CA_RADIUS = 0.45
@@ -49,6 +57,7 @@ SELECTION_RADIUS = 1.4
 POLYGON_COLOUR = (110, 110, 120)
 CA_STICK_COLOUR = (120, 124, 130)
 CAPTION_COLOUR = "#2b2f36"
+CAPTION_PIXELS = 15
 BACKGROUND = ("#ffffff", "#dfe5ec")
 
 
@@ -93,12 +102,18 @@ _ACTORS: dict[Layer, tuple[str, ...]] = {
     Layer.VALIDATION: ("validation_markers",),  # drawn by app.editor.scene.validation_markers
 }
 _SHINY = {"interpolation": "phong", "specular": 0.4, "specular_power": 25.0}
+_TUBE_STYLE = {"scalars": "colours", "rgb": True, "interpolation": "phong", "specular": 0.35, "specular_power": 25.0,
+               "diffuse": 0.8, "ambient": 0.18}
+_MOVING_TUBES = ("tube_edited", "tube_others")
+"""The tube while something moves: the edited segment's in full, the others' coarse."""
+_LINES_AS_TUBES = ("curve", "ca_sticks", "ligand_sticks")
+"""Meshes whose lines are shaded tubes at rest and plain lines while something moves."""
 
 
 class Scene(QObject):
     """Draws a :class:`Document` into a pyvista plotter and follows its signals."""
 
-    def __init__(self, document: Document, plotter: pv.BasePlotter) -> None:
+    def __init__(self, document: Document, plotter: View) -> None:
         super().__init__(document)
         self.document = document
         self.plotter = plotter
@@ -117,6 +132,13 @@ class Scene(QObject):
         self._shown_points = np.empty(0, dtype=np.int64)
         self._shown_xyz = np.empty((0, 3))
         self._shown_pick: Pick | None = None
+        self.moving = False
+        """Whether the view is drawn with less detail because something moves (see :meth:`moved`)."""
+        self._still_timer = QTimer(self, singleShot=True, interval=STILL_AFTER_MS)
+        self._still_timer.timeout.connect(self.still)
+        self._moving_rows: dict[str, np.ndarray] = {}
+        self._moving_segment: int | None = None  # the edited segment when the moving tube was cut
+        plotter.capturing.connect(lambda: self.still(render=False))
         plotter.set_background(BACKGROUND[0], top=BACKGROUND[1])
         plotter.renderer.AddObserver("StartEvent", lambda *_: self._size_points())
         document.loaded.connect(self._build)
@@ -161,6 +183,25 @@ class Scene(QObject):
         if self.document.editable:
             self._draw_others()
             self.plotter.render()
+
+    def moved(self) -> None:
+        """Something moves (the camera, a dragged point, the level slider): draw with less
+        detail until nothing has moved for :data:`STILL_AFTER_MS`, then once in full. Less
+        detail is: no FXAA, plain lines instead of shaded tubes, and the tube of the segments
+        not edited with a sixth of its vertices."""
+        self._still_timer.start()
+        if not self.moving:
+            self.moving = True
+            self._set_detail()
+
+    def still(self, render: bool = True) -> None:
+        """Full detail from now on (at once, as before a screenshot, or once nothing moves)."""
+        self._still_timer.stop()
+        if self.moving:
+            self.moving = False
+            self._set_detail()
+            if render:
+                self.plotter.render()
 
     def reset_camera(self) -> None:
         """Look at the structure (its Cα, or all atoms without a backbone) along its axis of
@@ -209,6 +250,9 @@ class Scene(QObject):
         self._shown_points = np.empty(0, dtype=np.int64)
         self.others = Others.SHOWN
         self._concealed = False
+        self.still(render=False)
+        self._moving_rows.clear()
+        self._moving_segment = None
         if self.document.editable:
             self._residue_offset = np.array([s.residue_index[0] for s in structure.segments])
             self._residue_chain = np.concatenate([np.full(len(s), s.chain) for s in structure.segments])
@@ -253,8 +297,7 @@ class Scene(QObject):
         for segment in range(len(paths)):
             self._sweep(segment, slice(None))
         self._tube_colours(self._residue_colours())
-        self._add("tube", scalars="colours", rgb=True, interpolation="phong", specular=0.35, specular_power=25.0,
-                  diffuse=0.8, ambient=0.18)
+        self._add("tube", **_TUBE_STYLE)
 
     def _build_curve(self) -> None:
         samples = [self.document.level_curve(g).samples for g in range(len(self.document.paths))]
@@ -303,6 +346,8 @@ class Scene(QObject):
         if len(residues):
             self._sweep(segment, _span(self.document.paths[segment].rings(residues)))
             table_rows = self._residue_offset[segment] + residues
+            if self._moving_rows:
+                self._copy_moving_tube("tube_edited" if segment == self._moving_segment else "tube_others")
             ca = model.coords[self.document.ca_rows[table_rows]]
             self._move_glyphs("ca_balls", _span(table_rows), ca)
             self._write("ca_sticks", _span(table_rows), ca)
@@ -331,6 +376,7 @@ class Scene(QObject):
             self.plotter.render()
 
     def _on_segment(self) -> None:
+        self.still(render=False)
         self._colour_curves()
         if self.others is not Others.SHOWN:
             self._draw_others()
@@ -493,11 +539,81 @@ class Scene(QObject):
             f"{document.structure.entry_id}   {document.segment_label(document.segment)}\n"
             f"level {document.shown_level():.2f} of {document.max_level:.2f}   "
             f"{document.level_curve().n_segments} curve segments")
-        if "caption" in self.actors:
-            self.actors["caption"].SetText(2, text)  # the upper-left corner of a corner annotation
-        else:
-            self.actors["caption"] = self.plotter.add_text(text, position="upper_left", font_size=9,
-                                                           color=CAPTION_COLOUR, name="caption", render=False)
+        if "caption" not in self.actors:  # a text actor of one font size (a corner annotation fits its
+            actor = vtkTextActor()        # size to the view at every frame: slow with software OpenGL)
+            style = actor.GetTextProperty()
+            style.SetFontSize(CAPTION_PIXELS)
+            style.SetColor(pv.Color(CAPTION_COLOUR).float_rgb)
+            style.SetVerticalJustificationToTop()
+            actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+            actor.SetPosition(0.008, 0.99)
+            self.actors["caption"] = actor
+            self.plotter.add_actor(actor, name="caption", reset_camera=False, render=False)
+        self.actors["caption"].SetInput(text)
+
+    # ------------------------------------------------------------------ level of detail
+
+    def _set_detail(self) -> None:
+        full = not self.moving
+        self.plotter.renderer.SetUseFXAA(full)
+        for name in _LINES_AS_TUBES:
+            if name in self.actors:
+                self.actors[name].prop.render_lines_as_tubes = full
+        self._moving_rows.clear()
+        if self.moving and "tube" in self.actors and len(self.document.paths) > 1:
+            self._cut_moving_tube()
+        self._show_tube()
+
+    def _cut_moving_tube(self) -> None:
+        """The tube while something moves, its vertices taken from the full tube's: the
+        edited segment's all (caps included), the other segments' every third ring and
+        every other side (no caps)."""
+        segment = self.document.segment
+        rows, faces = {}, {}
+        first, last = self._ring_start[segment] * TUBE_SIDES, self._ring_start[segment + 1] * TUBE_SIDES
+        caps = np.arange(self._cap_start[segment], self._cap_start[segment] + 2 * (TUBE_SIDES + 1))
+        rows["tube_edited"] = np.r_[first:last, caps]
+        n_rings = self.document.paths[segment].n_rings
+        faces["tube_edited"] = [tube.tube_faces(n_rings, TUBE_SIDES)] + [
+            tube.cap_faces(TUBE_SIDES, last - first + end * (TUBE_SIDES + 1)) for end in (0, 1)]
+        others, others_faces, start = [], [], 0
+        for g, path in enumerate(self.document.paths):
+            if g != segment:
+                kept, n_kept, sides = tube.coarse_rows(path.n_rings, TUBE_SIDES, MOVING_RING_STEP, MOVING_SIDE_STEP)
+                others.append(kept + self._ring_start[g] * TUBE_SIDES)
+                others_faces.append(tube.tube_faces(n_kept, sides, start))
+                start += len(kept)
+        rows["tube_others"], faces["tube_others"] = np.concatenate(others), others_faces
+        full = self.meshes["tube"]
+        for name in _MOVING_TUBES:
+            self._moving_rows[name] = rows[name]
+            if self._moving_segment != segment or name not in self.meshes:
+                mesh = pv.PolyData(np.asarray(full.points)[rows[name]], faces=_cells(faces[name]))
+                for array in ("Normals", "colours"):
+                    mesh.point_data[array] = np.asarray(full.point_data[array])[rows[name]]
+                mesh.point_data.active_normals_name = "Normals"
+                if name in self.meshes:
+                    self.meshes[name].shallow_copy(mesh)
+                else:
+                    self.meshes[name] = mesh
+                    self._add(name, **_TUBE_STYLE)
+            else:
+                self._copy_moving_tube(name, colours=True)
+        self._moving_segment = segment
+
+    def _copy_moving_tube(self, name: str, colours: bool = False) -> None:
+        """Copy the vertices (and normals, and ``colours``) of the moving tube ``name`` from the full tube."""
+        full, rows = self.meshes["tube"], self._moving_rows[name]
+        for array in (None, "Normals", "colours") if colours else (None, "Normals"):
+            source = full.GetPoints().GetData() if array is None else full.GetPointData().GetArray(array)
+            self._write(name, slice(None), vtk_to_numpy(source)[rows], array)
+
+    def _show_tube(self) -> None:
+        """The full tube at rest; while something moves, the moving tube when there is one."""
+        moving = bool(self._moving_rows)
+        for name in ("tube", *_MOVING_TUBES):
+            if name in self.actors:
+                self.actors[name].SetVisibility(Layer.TUBE in self.layers and (name != "tube") == moving)
 
     # ------------------------------------------------------------------ helpers
 
@@ -588,6 +704,7 @@ class Scene(QObject):
                     self.actors[name].SetVisibility(layer in self.layers)
         if "handle" in self.actors:
             self.actors["handle"].SetVisibility(self.document.pick is not None and Layer.CONTROL_POINTS in self.layers)
+        self._show_tube()
 
 
 def _faded(colours: np.ndarray, which: np.ndarray) -> np.ndarray:

@@ -97,6 +97,16 @@ def _ring_matrices(n_sides: int) -> tuple[np.ndarray, np.ndarray]:
     return circle, np.vstack([circle, np.tile(np.eye(3), n_sides)])
 
 
+def coarse_rows(n_rings: int, n_sides: int, ring_step: int, side_step: int) -> tuple[np.ndarray, int, int]:
+    """Rows of a tube's vertices that make a coarser tube of the same curve: every
+    ``ring_step``-th ring (the last one always) and every ``side_step``-th side (a divisor of
+    ``n_sides``: the sides kept still make a regular polygon). Returns the rows, ring by ring,
+    and the numbers of rings and sides kept."""
+    rings = np.unique(np.r_[np.arange(0, n_rings, ring_step), n_rings - 1])
+    sides = np.arange(0, n_sides, side_step)
+    return (rings[:, None] * n_sides + sides).ravel(), len(rings), len(sides)
+
+
 def tube_faces(n_rings: int, n_sides: int, first: int = 0) -> np.ndarray:
     """Quads (n, 4) joining consecutive rings of a tube whose vertices start at ``first``."""
     ring = np.arange(n_rings - 1)[:, None] * n_sides

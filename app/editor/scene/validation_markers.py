@@ -55,8 +55,8 @@ class ValidationMarkers(QObject):
         self.refresh()
 
     def refresh(self, render: bool = False) -> None:
-        """Show the markers of the flags shown; render after a deferred check or with ``render``
-        (the scene renders after each change)."""
+        """Show the markers of the flags shown; render with ``render``, or after a deferred check
+        that moved a marker when nothing moves (the scene renders after each change)."""
         triaged = self.validation.triaged
         if triaged is None:
             return
@@ -68,18 +68,23 @@ class ValidationMarkers(QObject):
             )
         positions, severity = marked(triaged.flags)
         colours = severity_colours(severity)
+        changed = True
         if len(positions) and len(positions) == self.mesh.n_points:
-            for target, values in ((self.mesh.GetPoints().GetData(), positions),
-                                   (self.mesh.GetPointData().GetArray("colours"), colours)):
-                vtk_to_numpy(target)[:] = values
-                target.Modified()
-            self.mesh.Modified()
-        else:
+            targets = (self.mesh.GetPoints().GetData(), positions), (self.mesh.GetPointData().GetArray("colours"), colours)
+            changed = not all(np.array_equal(vtk_to_numpy(target), values) for target, values in targets)
+            if changed:
+                for target, values in targets:
+                    vtk_to_numpy(target)[:] = values
+                    target.Modified()
+                self.mesh.Modified()
+        elif len(positions) or self.mesh.n_points:
             self.mesh.shallow_copy(_points(positions, colours))
+        else:
+            changed = False
         visible = Layer.VALIDATION in self.scene.layers
         self.scene.actors[NAME].SetVisibility(visible)
-        if visible and (self.validation.late or render):
-            self.scene.plotter.render()
+        if visible and (render or (self.validation.late and changed and not self.scene.moving)):
+            self.scene.plotter.render()  # (while something moves, its next frame or the still one shows them)
 
 
 def _points(positions: np.ndarray, colours: np.ndarray) -> pv.PolyData:

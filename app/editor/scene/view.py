@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from PySide6.QtCore import Signal
 from pyvista.plotting.plotter import BasePlotter
 from pyvistaqt import QtInteractor
 
@@ -20,6 +21,8 @@ from pyvistaqt import QtInteractor
 class View(QtInteractor):
     """A ``QtInteractor`` that renders once per paint and paints once per event-loop turn."""
 
+    capturing = Signal()
+    """A screenshot is about to be rendered (views draw their full detail)."""
     frames = 0
     """Frames rendered (for tests and benchmarks)."""
     _immediate = True  # while QtInteractor sets itself up
@@ -57,6 +60,7 @@ class View(QtInteractor):
 
     def screenshot(self, *args: Any, **kwargs: Any) -> Any:  # noqa: ANN401 (pyvista's)
         """pyvista's screenshot of what the document shows now: its renders are drawn at once."""
+        self.capturing.emit()
         self._immediate = True
         try:
             self.render()

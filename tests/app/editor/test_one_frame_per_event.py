@@ -10,18 +10,24 @@ from PySide6.QtWidgets import QApplication
 from pytestqt.qtbot import QtBot
 
 from app.editor.main_window import MainWindow
-from app.editor.scene.scene import Layer
+from app.editor.scene.scene import STILL_AFTER_MS, Layer
 
 Opener = Callable[[str], MainWindow]
 """The ``open_window`` fixture: a shown window on a file of tests/data."""
 
 
+def _still(qtbot: QtBot, window: MainWindow) -> None:
+    """Wait until the view is drawn in full detail again and nothing is pending."""
+    qtbot.waitUntil(lambda: not window.scene.moving, timeout=2000)
+    qtbot.wait(100)  # its frame, and the deferred validation check
+
+
 def _frames_of(qtbot: QtBot, window: MainWindow, send) -> int:  # noqa: ANN001 (a callable)
-    """Frames the view draws for the event ``send`` sends (the event loop run until idle)."""
-    qtbot.wait(150)  # nothing pending from before (the deferred validation check included)
+    """Frames the view draws for the event ``send`` sends, before full detail comes back."""
+    _still(qtbot, window)
     before = window.plotter.frames
     send()
-    qtbot.wait(150)
+    qtbot.wait(STILL_AFTER_MS // 2)
     return window.plotter.frames - before
 
 
@@ -41,7 +47,6 @@ def test_each_event_draws_one_frame(qtbot: QtBot, open_window: Opener) -> None:
     at = QPoint(round(x / view.devicePixelRatioF()), round(view.height() - 1 - y / view.devicePixelRatioF()))
     assert _frames_of(qtbot, window, lambda: qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=at)) == 1
     assert document.pick is not None and document.pick.index == index
-    window.scene.set_layer(Layer.VALIDATION, False)  # shown, its markers draw once more after each deferred check
     assert _frames_of(qtbot, window, lambda: qtbot.mouseMove(view, at + QPoint(30, 20))) == 1
     assert _frames_of(qtbot, window, lambda: qtbot.mouseRelease(view, Qt.MouseButton.LeftButton,
                                                                 pos=at + QPoint(30, 20))) == 1

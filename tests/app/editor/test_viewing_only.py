@@ -64,7 +64,7 @@ def test_dna_opens_in_the_window_for_viewing_and_surfaces(qtbot: QtBot, tmp_path
     assert Layer.ATOMS in scene.layers and scene.actors["atoms"].GetVisibility()  # shown: all there is to see
     assert window.display_panel.layer_boxes[Layer.ATOMS].isChecked()
     assert not {"tube", "curve", "control_points", "ca_balls"} & set(scene.meshes)
-    assert scene.actors["caption"].GetText(2) == REASON
+    assert scene.actors["caption"].GetInput() == REASON
 
     # editing is off, and the window says why
     panel = window.dimension_panel

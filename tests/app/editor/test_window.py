@@ -309,21 +309,6 @@ def test_a_drag_beside_the_points_turns_the_camera(window: MainWindow) -> None:
     assert window.document.undo_stack.count() == 0 and window.document.pick is None
 
 
-def test_frames_in_motion_skip_anti_aliasing(window: MainWindow) -> None:
-    renderer = window.plotter.renderer
-    interactor = window.plotter.iren.interactor
-    point = window.document.level_curve().control_points[int(window.scene.shown_control_points()[5])]
-    for start in (_display(window, point), (5, 5)):  # a drag of a point, then of the camera
-        assert renderer.GetUseFXAA()
-        interactor.SetEventInformation(*start)
-        interactor.InvokeEvent("LeftButtonPressEvent")
-        interactor.SetEventInformation(start[0] + 30, start[1] + 20)
-        interactor.InvokeEvent("MouseMoveEvent")
-        assert not renderer.GetUseFXAA()
-        interactor.InvokeEvent("LeftButtonReleaseEvent")
-        assert renderer.GetUseFXAA()
-
-
 def test_hidden_control_points_cannot_be_grabbed(window: MainWindow) -> None:
     point = window.document.level_curve().control_points[int(window.scene.shown_control_points()[5])]
     window.display_panel.layer_boxes[Layer.CONTROL_POINTS].setChecked(False)
