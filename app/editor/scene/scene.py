@@ -596,7 +596,7 @@ class Scene(QObject):
                     self.meshes[name].shallow_copy(mesh)
                 else:
                     self.meshes[name] = mesh
-                    self._add(name, **_TUBE_STYLE)
+                    self._add(name, **_TUBE_STYLE, culling="back")  # a third cheaper: no hidden side drawn
             else:
                 self._copy_moving_tube(name, colours=True)
         self._moving_segment = segment
