@@ -49,6 +49,8 @@ COMMANDS: dict[str, Command] = {
                        "app.cli.analysis"),
     "surface": Command("molecular surface, globe, DNA cylinder, remeshing or density map at a level, to .vtp/.ply/.png",
                        "app.cli.surface"),
+    "fit": Command("move a model onto another conformation, coarse to fine over the levels", "app.cli.fit"),
+    "morph": Command("a multi-model movie from one conformation to another, the coarse motion first", "app.cli.fit"),
     "validate": Command("geometry report: peptide junctions, Ramachandran outliers, clashes", "app.cli.validate"),
 }
 

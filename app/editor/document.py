@@ -27,12 +27,11 @@ from PySide6.QtGui import QUndoStack
 from app.editor.commands import EditCommand
 from app.editor.persistence import records
 from app.editor.scene.curves import LevelCurve, SegmentPath
-from app.editor.scene.molecule import ca_rows
 from core.geometry.regularize import FLANK, regularize_region, regularized
 from core.protein.model import Edit, EditableModel
 from core.protein.reading import read_bytes, read_structure
 from core.protein.ribbon import RibbonKind
-from core.protein.structure import Structure
+from core.protein.structure import Structure, ca_rows
 
 LEVELS_BELOW_MAX = 2
 """A file opens at the integer level nearest to ``log2 N - 2`` (a quarter of the detail:

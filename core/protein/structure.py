@@ -237,6 +237,18 @@ class Structure:
         return sum(len(s) for s in self.segments)
 
 
+def ca_rows(structure: Structure) -> np.ndarray:
+    """Row of ``structure.coords`` holding the Cα of each backbone residue, (n_residues,)."""
+    ca = np.concatenate([np.empty((0, 3)), *(s.ca for s in structure.segments)])
+    owner = structure.atom_residue
+    candidates = np.flatnonzero(owner >= 0)
+    match = candidates[np.all(structure.coords[candidates] == ca[owner[candidates]], axis=1)]
+    residues, first = np.unique(owner[match], return_index=True)
+    if len(residues) != len(ca):
+        raise ValueError("every backbone residue must own the atom at its Cα position")
+    return match[first]
+
+
 def frozen(array: np.ndarray) -> np.ndarray:
     """``array`` as a contiguous, read-only array: how a structure keeps its arrays."""
     array = np.ascontiguousarray(array)

@@ -7,6 +7,7 @@ import gzip
 import os
 import re
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import gemmi
@@ -110,6 +111,44 @@ def write_structure(
     return path
 
 
+def write_models(
+    structure: Structure,
+    frames: Sequence[NDArray[np.float64]],
+    path: str | os.PathLike[str],
+    *,
+    overwrite: bool = False,
+) -> Path:
+    """Write one model per frame (each ``(structure.n_atoms, 3)``, Å) of ``structure``'s
+    model, numbered from 1: a multi-model PDB or mmCIF file that molecular viewers play as
+    a movie. The header of the input is kept; the write is atomic. Raises as
+    :func:`write_structure` does."""
+    path = Path(path)
+    fmt, compress = _output_format(path)
+    if not frames:
+        raise StructureError(f"{path}: no frames to write")
+    frames = [_checked_coords(structure, coords) for coords in frames]
+    if fmt == "pdb":
+        for coords in frames:
+            _check_pdb_columns(structure, coords, path)
+    if not overwrite and path.exists():
+        raise FileExistsError(f"{path}: refusing to overwrite an existing file")
+    st = structure._template.clone()
+    template = st[structure.model_number - 1].clone()
+    for k in reversed(range(len(st))):
+        del st[k]
+    for number, coords in enumerate(frames, start=1):
+        model = _moved_model(template, coords)
+        model.num = number
+        st.add_model(model)
+    try:
+        text = _pdb_text(st, structure, moved=True) if fmt == "pdb" else st.make_mmcif_document().as_string()
+    except RuntimeError as exc:
+        raise StructureError(f"{path}: cannot write {fmt.upper()} ({exc})") from None
+    data = text.encode(structure._encoding)
+    atomic_write(path, gzip.compress(data, mtime=0) if compress else data)
+    return path
+
+
 def _checked_coords(structure: Structure, coords: NDArray[np.float64]) -> np.ndarray:
     coords = np.asarray(coords, dtype=np.float64)
     if coords.shape != structure.coords.shape:
@@ -152,12 +191,23 @@ def _output_format(path: Path) -> tuple[str, bool]:
 def _moved(structure: Structure, coords: np.ndarray) -> gemmi.Structure:
     """A copy of the parsed file with the atoms of the structure's model at ``coords``."""
     st = structure._template.clone()
+    _place(st[structure.model_number - 1], coords)
+    return st
+
+
+def _moved_model(template: gemmi.Model, coords: np.ndarray) -> gemmi.Model:
+    """A copy of ``template`` with its atoms at ``coords``."""
+    model = template.clone()
+    _place(model, coords)
+    return model
+
+
+def _place(model: gemmi.Model, coords: np.ndarray) -> None:
     rows = iter(np.round(coords, 3).tolist())
-    for ch in st[structure.model_number - 1]:
+    for ch in model:
         for res in ch:
             for atom in res:
                 atom.pos = gemmi.Position(*next(rows))
-    return st
 
 
 def _pdb_text(st: gemmi.Structure, structure: Structure, moved: bool) -> str:

@@ -97,18 +97,6 @@ def element_colours(elements: np.ndarray, carbon: RGB | None = None) -> np.ndarr
     return np.array([table.get(e.upper(), OTHER_ELEMENT) for e in elements], dtype=np.uint8).reshape(-1, 3)
 
 
-def ca_rows(structure: Structure) -> np.ndarray:
-    """Row of ``structure.coords`` holding the Cα of each backbone residue, (n_residues,)."""
-    ca = np.concatenate([np.empty((0, 3)), *(s.ca for s in structure.segments)])
-    owner = structure.atom_residue
-    candidates = np.flatnonzero(owner >= 0)
-    match = candidates[np.all(structure.coords[candidates] == ca[owner[candidates]], axis=1)]
-    residues, first = np.unique(owner[match], return_index=True)
-    if len(residues) != len(ca):
-        raise ValueError("every backbone residue must own the atom at its Cα position")
-    return match[first]
-
-
 def bonds(coords: np.ndarray, elements: np.ndarray, altloc: np.ndarray, atoms: np.ndarray) -> np.ndarray:
     """Covalent bonds (b, 2) among the atom rows ``atoms``, by distance.
 
