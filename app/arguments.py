@@ -9,6 +9,10 @@ from collections.abc import Callable
 
 LEVEL = (0.0, 30.0)
 """Carson levels: log2 of a segment's residues stays far below 30."""
+IMAGE_SIDE = (1, 16384)
+"""Pixels of an exported image's width or height."""
+SUPERSAMPLING = (1, 2, 4)
+"""Factors an exported image may be rendered larger by and averaged down."""
 
 
 def bounded(kind: type, low: float, high: float) -> Callable[[str], float | int]:

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from app import DEFAULT_STRUCTURE, PROG
-from app.arguments import LEVEL, bounded
+from app.arguments import IMAGE_SIDE, LEVEL, SUPERSAMPLING, bounded
 from app.errors import InputError
 from core.protein.structure import StructureError
 
@@ -59,9 +59,40 @@ def open_arguments(parser: argparse.ArgumentParser) -> None:
         help="render the window to a PNG image and exit instead of running interactively",
     )
     parser.add_argument(
+        "--export-image",
+        type=Path,
+        metavar="OUT.png",
+        help="render the 3D view to a PNG image, as File > Export Image does, and exit",
+    )
+    parser.add_argument(
+        "--width",
+        type=bounded(int, *IMAGE_SIDE),
+        metavar="W",
+        help="--export-image width in pixels (default: by --height and the view's aspect ratio, or the view's)",
+    )
+    parser.add_argument(
+        "--height",
+        type=bounded(int, *IMAGE_SIDE),
+        metavar="H",
+        help="--export-image height in pixels (default: by --width and the view's aspect ratio, or the view's)",
+    )
+    parser.add_argument(
+        "--supersample",
+        type=int,
+        choices=SUPERSAMPLING,
+        metavar="N",
+        help="--export-image as the mean of N x N renderings shifted within each pixel, smoothing edges: "
+        f"{', '.join(map(str, SUPERSAMPLING))} (default 1)",
+    )
+    parser.add_argument(
+        "--transparent",
+        action="store_true",
+        help="--export-image on a transparent background (alpha 0 behind the scene)",
+    )
+    parser.add_argument(
         "--overwrite",
         action="store_true",
-        help="replace the --screenshot image if it exists",
+        help="replace the --screenshot or --export-image image if it exists",
     )
     parser.add_argument(
         "--model",
@@ -100,21 +131,29 @@ def open_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_open(args: argparse.Namespace) -> int:
-    """Open the editor on what the arguments name; with ``--script`` or ``--screenshot``, do
-    that and exit (the exit status), else run until the window closes."""
+    """Open the editor on what the arguments name; with ``--script``, ``--screenshot`` or
+    ``--export-image``, do that and exit (the exit status), else run until the window closes."""
+    if args.export_image is None:
+        given = [f"--{name}" for name in ("width", "height", "supersample", "transparent")
+                 if getattr(args, name) not in (None, False)]
+        if given:
+            raise InputError(f"{', '.join(given)}: only with --export-image (the 3D view; --screenshot takes the "
+                             "whole window)")
     # Qt and VTK load only for the window, so commands without one start fast.
     from PySide6.QtWidgets import QApplication
 
+    from app.editor.export_image import export_view
     from app.editor.main_window import MainWindow
 
     if sys.platform.startswith("linux"):
         _check_display()
     script = _read_script(args.script) if args.script is not None else None
-    if args.screenshot is not None:
-        _check_output(args.screenshot, args.overwrite)
+    images = [path for path in (args.screenshot, args.export_image) if path is not None]
+    for path in images:
+        _check_output(path, args.overwrite)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     window = MainWindow()
-    window.unattended = script is not None or args.screenshot is not None
+    window.unattended = script is not None or bool(images)
     try:
         _load(window, args)
     except InputError:
@@ -127,13 +166,20 @@ def run_open(args: argparse.Namespace) -> int:
     if script is not None:
         app.processEvents()  # the window laid out, as a person would first see it
         status = _run_script(window, args.script, script)
-    if window.isVisible() and args.screenshot is not None:
+    if window.isVisible() and images:
         app.processEvents()  # lay the window out before it is grabbed
         try:
-            window.save_screenshot(args.screenshot, overwrite=args.overwrite)
+            if args.screenshot is not None:
+                window.save_screenshot(args.screenshot, overwrite=args.overwrite)
+            if args.export_image is not None:
+                export_view(window.plotter, args.export_image, args.width, args.height,
+                            supersample=args.supersample or 1, transparent=args.transparent, overwrite=args.overwrite)
         except OSError as error:
             window.close()
             raise InputError(str(error)) from error
+        except ValueError as error:  # a size the export refuses
+            window.close()
+            raise InputError(f"--export-image: {error}") from error
     if window.unattended:
         window.close()
         kept = window.journal.kept

@@ -4,8 +4,9 @@ The window wires the pieces together: a :class:`~app.editor.document.Document`, 
 :class:`~app.editor.scene.scene.Scene` drawing it into the :class:`~app.editor.scene.view.View`, the
 :class:`~app.editor.picking.PointerAdapter` feeding mouse events to the
 :class:`~app.editor.drag.DragController`, and the dock panels. It also owns the file dialogs
-(open, save, recent files, drag-and-drop, image export) and asks before unsaved edits
-would be lost. The ``app`` package sets ``QT_API`` before this module imports pyvistaqt.
+(open, save, recent files, drag-and-drop; image export is :mod:`app.editor.export_image`'s)
+and asks before unsaved edits would be lost. The ``app`` package sets ``QT_API`` before this
+module imports pyvistaqt.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QBuffer, QByteArray, QIODevice, QPoint, QSettings, QSize, Qt
+from PySide6.QtCore import QPoint, QSettings, QSize, Qt
 from PySide6.QtGui import (
     QAction,
     QActionGroup,
@@ -56,6 +57,7 @@ from app.editor.docks.surfaces import SurfaceLayer, SurfacePanel
 from app.editor.docks.validation import ValidationPanel
 from app.editor.document import Document
 from app.editor.drag import CLICK_PIXELS, DragController, Mode, PointerEvent
+from app.editor.export_image import ExportImageDialog, render_view, write_png
 from app.editor.identify import Hit, describe, identify
 from app.editor.live_validation import LiveValidation
 from app.editor.persistence import journal, records, session
@@ -69,7 +71,6 @@ from app.editor.scripting import EditorAPI
 from core.geometry.validation import Flag
 from core.protein.lookup import find_residues
 from core.protein.structure import StructureError
-from core.protein.writing import atomic_write
 
 APP_NAME = "ribbonwave"
 RECENT_KEY = "recentFiles"
@@ -252,15 +253,6 @@ class MainWindow(QMainWindow):
         elif answer == buttons.Discard:
             left[0].unlink(missing_ok=True)
 
-    def export_view(self, path: Path, width: int | None = None, height: int | None = None, *,
-                    overwrite: bool = False) -> Path:
-        """Save the 3D view as a PNG image of ``width`` x ``height`` pixels (default: the view's),
-        atomically; an existing file only with ``overwrite`` (else FileExistsError)."""
-        size = None if width is None and height is None else (width or self.plotter.width(),
-                                                               height or self.plotter.height())
-        write_png(_image(self.plotter.screenshot(return_img=True, window_size=size)), Path(path), overwrite=overwrite)
-        return Path(path)
-
     def quit_unattended(self, discard: bool = False) -> None:
         """Close without asking: unsaved edits are kept in the journal unless ``discard``."""
         self.unattended = True
@@ -295,20 +287,11 @@ class MainWindow(QMainWindow):
                 return False
         return self._write(path)
 
-    def export_image(self, path: Path | None = None) -> bool:
-        """Save the 3D view as a PNG image (asks for the name when ``path`` is None)."""
-        if path is None:
-            name, _ = QFileDialog.getSaveFileName(self, "Export Image", str(Path.home() / "ribbonwave.png"),
-                                                  "PNG image (*.png)")
-            if not name:
-                return False
-            path = Path(name) if name.lower().endswith(".png") else Path(name + ".png")
-        try:
-            self.export_view(path, overwrite=True)  # the dialog asked about an existing file
-        except OSError as error:
-            QMessageBox.critical(self, APP_NAME, f"cannot write {path}: {error.strerror or error}")
-            return False
-        return True
+    def export_image_dialog(self) -> ExportImageDialog:
+        """File ▸ Export Image: the dialog of size, supersampling and background, shown (not waited for)."""
+        dialog = ExportImageDialog(self.plotter, self._suggested(".png"), self)
+        dialog.open()
+        return dialog
 
     def recent_files(self) -> list[str]:
         """Files opened or saved lately, newest first (absolute paths)."""
@@ -348,7 +331,7 @@ class MainWindow(QMainWindow):
     def grab_window(self) -> QImage:
         """An image of the whole window with the freshly rendered 3D view painted in."""
         image = self.grab().toImage()
-        view = self._view_image()
+        view = render_view(self.plotter, *self.plotter.window_size)
         painter = QPainter(image)
         corner = self.plotter.mapTo(self, QPoint(0, 0))
         painter.drawImage(corner, view.scaled(self.plotter.size()))
@@ -406,7 +389,7 @@ class MainWindow(QMainWindow):
         self.open_session_action = self._action("Open Sess&ion…", QKeySequence("Ctrl+Shift+O"),
                                                 self._open_session_dialog)
         self.save_session_action = self._action("Save Sessio&n…", QKeySequence("Ctrl+Alt+S"), self.save_session)
-        self.export_action = self._action("&Export Image…", QKeySequence("Ctrl+E"), lambda: self.export_image())
+        self.export_action = self._action("&Export Image…", QKeySequence("Ctrl+E"), self.export_image_dialog)
         self.quit_action = self._action("&Quit", QKeySequence.StandardKey.Quit, self.close)
         stack = self.document.undo_stack
         self.undo_action = stack.createUndoAction(self, "&Undo")
@@ -805,31 +788,6 @@ class MainWindow(QMainWindow):
             f"{idle} Drag elsewhere to turn the view." if pick is None
             else f"point {pick.index} moves {len(pick.residues)} residues: {document.residue_range(pick.residues)}"
         )
-
-    def _view_image(self) -> QImage:
-        """The 3D view rendered now, as an image."""
-        return _image(self.plotter.screenshot(return_img=True))
-
-
-def _image(pixels: np.ndarray) -> QImage:
-    """An (h, w, 3) uint8 RGB array as an image."""
-    pixels = np.ascontiguousarray(pixels[..., :3])
-    height, width = pixels.shape[:2]
-    return QImage(pixels.data, width, height, 3 * width, QImage.Format.Format_RGB888).copy()
-
-
-def write_png(image: QImage, path: Path, *, overwrite: bool = False) -> None:
-    """Write ``image`` as PNG the way structures are written: to a temporary file beside
-    ``path``, then renamed onto it (never through a link); an existing ``path`` only with
-    ``overwrite`` (else FileExistsError)."""
-    if not overwrite and (path.exists() or path.is_symlink()):
-        raise FileExistsError(f"{path}: refusing to overwrite an existing file")
-    data = QByteArray()
-    buffer = QBuffer(data)
-    buffer.open(QIODevice.OpenModeFlag.WriteOnly)
-    if not image.save(buffer, "PNG"):
-        raise OSError(f"{path}: cannot encode the image")
-    atomic_write(path, bytes(data))
 
 
 def _fitted(size: QSize) -> QSize:

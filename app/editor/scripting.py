@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from app.editor.export_image import export_view
 from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
 
 if TYPE_CHECKING:
@@ -150,9 +151,13 @@ class EditorAPI:
         return self._window.write_session(Path(path))
 
     def screenshot(self, path: str | Path, width: int | None = None, height: int | None = None, *,
-                   overwrite: bool = False) -> Path:
-        """Save the 3D view as a PNG image, ``width`` x ``height`` pixels (default: the view's size)."""
-        return self._window.export_view(Path(path), width, height, overwrite=overwrite)
+                   supersample: int = 1, transparent: bool = False, overwrite: bool = False) -> Path:
+        """Save the 3D view as a PNG image as File ▸ Export Image does: ``width`` x ``height``
+        pixels (one given: the other by the view's aspect ratio; none: the view's size), rendered
+        ``supersample`` (1, 2 or 4) times larger and averaged down, on a transparent background
+        if ``transparent``."""
+        return export_view(self._window.plotter, Path(path), width, height, supersample=supersample,
+                           transparent=transparent, overwrite=overwrite)
 
     def quit(self, discard: bool = False) -> None:
         """Close the editor. Unsaved edits stay in the recovery journal unless ``discard``."""

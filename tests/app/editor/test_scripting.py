@@ -86,6 +86,13 @@ def test_screenshot_of_a_given_size(qtbot: QtBot, tmp_path: Path) -> None:
     assert (image.width(), image.height()) == (320, 240)
     colours = {image.pixel(x, y) for x in range(0, 320, 8) for y in range(0, 240, 8)}
     assert len(colours) > 20  # a drawing, not a blank frame
+    window.rw.screenshot(tmp_path / "clear.png", 320, supersample=4, transparent=True)  # as File ▸ Export Image
+    image = QImage(str(tmp_path / "clear.png"))
+    view_width, view_height = window.plotter.window_size
+    assert (image.width(), image.height()) == (320, round(320 * view_height / view_width))
+    assert image.hasAlphaChannel() and image.pixelColor(0, image.height() - 1).alpha() == 0
+    with pytest.raises(ValueError, match="supersampling must be one of 1, 2, 4"):
+        window.rw.screenshot(tmp_path / "odd.png", supersample=3)
 
 
 def test_a_script_runs_in_the_editor_with_a_screenshot(tmp_path: Path, state_home: Path,

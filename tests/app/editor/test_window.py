@@ -398,13 +398,6 @@ def test_dropping_a_file_opens_it(window: MainWindow) -> None:
     assert window.plotter.actors["ligand_balls"].GetVisibility()  # the haems, ball-and-stick
 
 
-def test_export_image(window: MainWindow, tmp_path: Path) -> None:
-    assert window.export_image(tmp_path / "view.png")
-    image = QImage(str(tmp_path / "view.png"))
-    assert image.width() == window.plotter.width()
-    assert _colour_counts(_pixels(image))["helix"] > 200
-
-
 # ------------------------------------------------------------------ the command line
 
 
