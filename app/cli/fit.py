@@ -76,7 +76,7 @@ def run_fit(args: argparse.Namespace) -> int:
     report = {
         "model": str(args.file), "target": str(args.to), "pairing": pairing,
         "pairs": sum(len(p.residues) for p in pairs),
-        "levels": [{"level": f.level, "control_points": f.control_points, "rmsd": round(f.rmsd, 4),
+        "levels": [{"level": f.level, "control_points": f.control_points, "rmsd": round(f.score, 4),
                     "seconds": round(f.seconds, 4)} for f in fits],
         "dropped_levels": result.dropped, "regularized": args.regularize, "rmsd": round(rmsd, 4),
         "validation": {kind: {"before": before[kind], "after": after[kind]} for kind, _ in CHECKED},
@@ -87,7 +87,7 @@ def run_fit(args: argparse.Namespace) -> int:
         return 0
     print(f"{report['pairs']} residue pairs ({pairing}); Cα rmsd to the target after each level:")
     for f in fits:
-        print(f"  level {f.level}: {f.control_points:4d} control points, Cα rmsd {f.rmsd:6.3f} Å, {f.seconds:6.2f} s")
+        print(f"  level {f.level}: {f.control_points:4d} control points, Cα rmsd {f.score:6.3f} Å, {f.seconds:6.2f} s")
     if result.dropped:
         print(f"  levels {', '.join(map(str, result.dropped))} undone: the regularized model kept more bad peptide "
               "junctions than the input (the target's backbone differs at that detail)")
@@ -124,7 +124,7 @@ def run_morph(args: argparse.Namespace) -> int:
     except (ValueError, OSError) as error:
         raise InputError(str(error)) from None
     print(f"{sum(len(p.residues) for p in pairs)} residue pairs ({pairing}); levels "
-          + ", ".join(f"{f.level} ({f.rmsd:.2f} Å)" for f in fits))
+          + ", ".join(f"{f.level} ({f.score:.2f} Å)" for f in fits))
     print(f"wrote {len(frames)} frames to {written}")
     return 0
 

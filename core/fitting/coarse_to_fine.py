@@ -28,6 +28,7 @@ from core.analysis.superpose import superpose
 from core.curves.filters import level_filters
 from core.curves.splines import spline_space
 from core.protein.model import Edit, EditableModel
+from core.protein.ribbon import Ribbon
 
 STEPS_PER_LEVEL = 4
 """Most Gauss–Newton steps at one level."""
@@ -61,7 +62,8 @@ class LevelFit:
     ----------
     level : the integer level fitted.
     control_points : unknown control points at that level, over all fitted segments.
-    rmsd : Cα rmsd of the paired residues to the superposed target after the level, Å.
+    score : after the level, the Cα rmsd of the paired residues to the superposed target
+        (Å), or for a map the correlation of the model's density with it.
     seconds : time the level took.
     edits : one edit per fitted segment (already applied to the model), from the state
         before this level to the state after it.
@@ -69,7 +71,7 @@ class LevelFit:
 
     level: int
     control_points: int
-    rmsd: float
+    score: float
     seconds: float
     edits: tuple[Edit, ...]
 
@@ -137,9 +139,15 @@ def _step(model: EditableModel, pairs: Pairs, level: int, target: np.ndarray, ca
     ribbon = model.ribbons[pairs.segment]
     level = min(level, ribbon.level)
     push = pushed_to_finest(level, ribbon.level)
-    design = (ribbon.space.design_matrix(ribbon.residue_u[pairs.residues]) @ push).toarray()
+    change = damped_change(ribbon, pairs.residues, push, target - ca)
+    return model.plan(pairs.segment, ribbon.points + push @ change)
+
+
+def damped_change(ribbon: Ribbon, residues: np.ndarray, push: sparse.csr_array, wanted: np.ndarray) -> np.ndarray:
+    """The change of a level's control points (pushed to the finest by ``push``) that moves
+    the curve points of ``residues`` closest to ``wanted`` (k, 3), damped a little."""
+    design = (ribbon.space.design_matrix(ribbon.residue_u[residues]) @ push).toarray()
     damping = DAMPING * np.sqrt(np.mean(design**2) * len(design))  # keeps points that few residues see in place
     system = np.vstack([design, damping * np.eye(design.shape[1])])
-    residual = np.vstack([target - ca, np.zeros((design.shape[1], 3))])
-    change, *_ = np.linalg.lstsq(system, residual, rcond=None)
-    return model.plan(pairs.segment, ribbon.points + push @ change)
+    change, *_ = np.linalg.lstsq(system, np.vstack([wanted, np.zeros((design.shape[1], 3))]), rcond=None)
+    return change

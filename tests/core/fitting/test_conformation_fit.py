@@ -33,7 +33,7 @@ def test_adenylate_kinase_reaches_the_other_conformation(start: str, end: str) -
     initial = superpose(structure.coords[rows], pairs[0].target).rmsd
     assert initial > 6.5  # the LID and NMP domains close over the site
     result = fit_conformation(model, pairs, range(0, 7))
-    rmsd = [fit.rmsd for fit in result.levels]
+    rmsd = [fit.score for fit in result.levels]
     assert [fit.level for fit in result.levels] == list(range(7)) and not result.dropped
     assert [fit.control_points for fit in result.levels] == [2**j + 3 for j in range(7)]
     assert all(b <= a + 1e-9 for a, b in zip(rmsd, rmsd[1:]))  # each level only adds detail

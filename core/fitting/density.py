@@ -1,0 +1,224 @@
+"""Fit a model into a density map coarse to fine: the map–model correlation as objective.
+
+The model's density is a sum of Gaussians, one per heavy atom, of width
+``σ = R / (π √2)`` for a map of resolution ``R`` (as Chimera's ``molmap`` simulates maps),
+computed on an orthogonal grid by spreading the atoms trilinearly and blurring with
+:func:`scipy.ndimage.gaussian_filter`. The map is resampled once onto that grid, in a box
+around the model. The objective is their correlation about the mean (CC), whose gradient
+with respect to every atom is the blurred derivative field interpolated at the atom.
+
+At each level the model follows a preconditioned gradient ascent: the CC's gradient summed
+over each residue's atoms asks each residue to move a little; the level's control points
+take the damped least-squares change that moves the residue points so (as in
+:mod:`core.fitting.coarse_to_fine`); the residues are remapped exactly and the step is kept if
+the CC rose, growing the next step, or undone and halved.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+from scipy.spatial import cKDTree
+
+from core.curves.splines import spline_space
+from core.fitting.coarse_to_fine import LevelFit, damped_change, pushed_to_finest
+from core.protein.model import Edit, EditableModel
+from core.protein.structure import ca_rows
+from core.surfaces.volume import DensityMap, MapError
+
+SIGMA_PER_RESOLUTION = 1.0 / (np.pi * np.sqrt(2.0))
+"""Gaussian width of an atom per Å of resolution (Chimera's ``molmap``)."""
+RESOLUTION = (2.0, 30.0)
+"""Å: the resolutions a fit takes."""
+MIN_OVERLAP = 0.5
+"""Fewest of the model's atoms that must lie inside the map."""
+FIRST_STEP = 0.25
+"""Largest residue move of a level's first step, in units of the resolution."""
+SMALLEST_STEP = 0.02
+"""Å: a level ends when its step has shrunk below this."""
+STEPS_PER_LEVEL = 100
+STIFFNESS = 0.003
+"""CC per Å² of mean squared change of the elastic network's spring lengths."""
+ELASTIC_CUTOFF = 10.0
+"""Å: Cα closer than this at the start are joined by springs."""
+
+
+def gaussian_sigma(resolution: float) -> float:
+    """Å, the Gaussian width of an atom in a map of ``resolution`` Å."""
+    return SIGMA_PER_RESOLUTION * resolution
+
+
+class MapTarget:
+    """A map around a model, resampled on an orthogonal grid, and the model's density on it.
+
+    Parameters
+    ----------
+    density : the map.
+    resolution : Å, the map's resolution (the model's density is blurred to it).
+    around : (n, 3) atom positions the box is built around, Å.
+    margin : Å beyond the atoms (default three Gaussian widths and 5 Å for the motion).
+    """
+
+    def __init__(self, density: DensityMap, resolution: float, around: np.ndarray, margin: float | None = None) -> None:
+        if not RESOLUTION[0] <= resolution <= RESOLUTION[1]:
+            raise ValueError(f"resolution must be in [{RESOLUTION[0]:g}, {RESOLUTION[1]:g}] Å; got {resolution:g}")
+        self.resolution = float(resolution)
+        self.sigma = gaussian_sigma(resolution)
+        self.spacing = float(np.clip(resolution / 4.0, 0.5, 2.5))
+        margin = 3.0 * self.sigma + 5.0 if margin is None else margin
+        inside = _inside(density, around)
+        if inside.mean() < MIN_OVERLAP:
+            raise MapError(f"the map does not overlap the model: {inside.mean():.0%} of its atoms lie inside the map "
+                           f"(at least {MIN_OVERLAP:.0%} must)")
+        self.origin = around.min(axis=0) - margin
+        self.shape = tuple(np.ceil((around.max(axis=0) + margin - self.origin) / self.spacing).astype(int) + 1)
+        points = self.origin + np.stack(np.indices(self.shape), axis=-1).reshape(-1, 3) * self.spacing
+        index = (points - density.origin) @ np.linalg.inv(density.axes)
+        values = ndimage.map_coordinates(density.values.astype(np.float64), index.T, order=1, mode="nearest")
+        values = values.reshape(self.shape)
+        self._target = values - values.mean()
+        self._target_norm = float(np.linalg.norm(self._target))
+        if self._target_norm == 0.0:
+            raise MapError("the map is flat around the model: nothing to fit into")
+
+    def density(self, coords: np.ndarray) -> np.ndarray:
+        """The model's density on the grid for atoms at ``coords`` (n, 3)."""
+        spread = np.zeros(self.shape)
+        index = (coords - self.origin) / self.spacing
+        base = np.floor(index).astype(int)
+        frac = index - base
+        for corner in np.ndindex(2, 2, 2):
+            weight = np.prod(np.where(corner, frac, 1.0 - frac), axis=1)
+            at = base + corner
+            keep = np.all((at >= 0) & (at < self.shape), axis=1)
+            np.add.at(spread, tuple(at[keep].T), weight[keep])
+        return ndimage.gaussian_filter(spread, self.sigma / self.spacing, mode="constant", truncate=3.0)
+
+    def correlation(self, coords: np.ndarray) -> float:
+        """CC about the mean of the model's density with the map."""
+        model = self.density(coords)
+        model -= model.mean()
+        norm = float(np.linalg.norm(model))
+        return float(np.sum(model * self._target) / (norm * self._target_norm)) if norm > 0 else 0.0
+
+    def gradient(self, coords: np.ndarray) -> tuple[float, np.ndarray]:
+        """The CC and its gradient (n, 3) with respect to each atom's position (1/Å)."""
+        model = self.density(coords)
+        model -= model.mean()
+        norm = float(np.linalg.norm(model))
+        if norm == 0.0:
+            return 0.0, np.zeros_like(coords)
+        cc = float(np.sum(model * self._target) / (norm * self._target_norm))
+        field = self._target / (norm * self._target_norm) - cc * model / norm**2  # dCC / d(model density)
+        index = ((coords - self.origin) / self.spacing).T
+        sigma = self.sigma / self.spacing
+        gradient = np.empty_like(coords)
+        for axis in range(3):
+            order = [0, 0, 0]
+            order[axis] = 1
+            derivative = ndimage.gaussian_filter(field, sigma, order=order, mode="constant", truncate=3.0)
+            gradient[:, axis] = ndimage.map_coordinates(derivative, index, order=1, mode="constant") / self.spacing
+        return cc, gradient
+
+
+def heavy_atoms(model: EditableModel) -> np.ndarray:
+    """Rows of the model's heavy atoms (no hydrogens, no waters): those a map shows."""
+    atoms = model.structure.atoms
+    return np.flatnonzero(~np.isin(np.char.upper(atoms.element.astype(str)), ("H", "D")) & (atoms.category != "water"))
+
+
+class ElasticNetwork:
+    """Springs between Cα closer than ``cutoff`` (Å) at rest: the energy, mean squared
+    change of their lengths (Å²), keeps the fit from molding a chain into any density."""
+
+    def __init__(self, ca: np.ndarray, cutoff: float = ELASTIC_CUTOFF) -> None:
+        pairs = cKDTree(ca).query_pairs(cutoff, output_type="ndarray")
+        self.i, self.j = pairs[:, 0], pairs[:, 1]
+        self.rest = np.linalg.norm(ca[self.i] - ca[self.j], axis=1)
+
+    def gradient(self, ca: np.ndarray) -> tuple[float, np.ndarray]:
+        """The energy and its gradient (n, 3) with respect to each Cα."""
+        vector = ca[self.i] - ca[self.j]
+        length = np.linalg.norm(vector, axis=1)
+        stretch = length - self.rest
+        n = max(len(stretch), 1)
+        force = (2.0 / n) * (stretch / np.maximum(length, 1e-9))[:, None] * vector
+        gradient = np.zeros_like(ca)
+        np.add.at(gradient, self.i, force)
+        np.add.at(gradient, self.j, -force)
+        return float(np.sum(stretch**2) / n), gradient
+
+
+def fit_map_levels(
+    model: EditableModel,
+    segments: Sequence[int],
+    target: MapTarget,
+    levels: Sequence[int],
+    *,
+    stiffness: float = STIFFNESS,
+    cancelled: Callable[[], bool] = lambda: False,
+) -> Iterator[LevelFit]:
+    """Fit ``model``'s ``segments`` into ``target`` at each of ``levels`` in turn (coarse
+    first), applying each level's edits to ``model`` and yielding them; a level's score is
+    the CC after it. The objective is the CC less ``stiffness`` times the energy of an
+    elastic network of the Cα as they are at the start (:class:`ElasticNetwork`)."""
+    rows = heavy_atoms(model)
+    ca = ca_rows(model.structure)[np.concatenate([model.segments[s].residue_index for s in segments])]
+    network = ElasticNetwork(model.coords[ca])
+
+    def objective() -> tuple[float, float, np.ndarray]:
+        cc, gradient = target.gradient(model.coords[rows])
+        energy, pull = network.gradient(model.coords[ca])
+        total = np.zeros((model.structure.n_atoms, 3))
+        total[rows] = gradient
+        total[ca] -= stiffness * pull
+        return cc - stiffness * energy, cc, total
+
+    for level in levels:
+        if cancelled():
+            return
+        start = time.perf_counter()
+        edits: dict[int, Edit] = {}
+        value, cc, gradient = objective()
+        step = FIRST_STEP * target.resolution
+        for _ in range(STEPS_PER_LEVEL):
+            if step < SMALLEST_STEP or cancelled():
+                break
+            planned = [_step(model, segment, level, gradient, step) for segment in segments]
+            for edit in planned:
+                model.apply(edit)
+            new_value, new_cc, new_gradient = objective()
+            if new_value > value:
+                value, cc, gradient, step = new_value, new_cc, new_gradient, step * 1.5
+                for edit in planned:
+                    edits[edit.segment] = edits[edit.segment].then(edit) if edit.segment in edits else edit
+            else:
+                for edit in reversed(planned):
+                    model.revert(edit)
+                step /= 2.0
+        n_points = sum(spline_space(min(level, model.ribbons[s].level)).n_points for s in segments)
+        yield LevelFit(level, n_points, cc, time.perf_counter() - start, tuple(edits.values()))
+
+
+def _step(model: EditableModel, segment: int, level: int, gradient: np.ndarray, largest: float) -> Edit:
+    """The planned edit of ``segment`` that moves its residues along the objective's gradient
+    (per atom, (n_atoms, 3), summed over each residue), the residue that moves most by ``largest`` Å."""
+    backbone, ribbon = model.segments[segment], model.ribbons[segment]
+    running = np.cumsum(np.vstack([np.zeros((1, 3)), gradient]), axis=0)
+    sums = running[backbone.atom_stop] - running[backbone.atom_start]
+    size = np.linalg.norm(sums, axis=1).max()
+    wanted = sums * (largest / size) if size > 0 else sums
+    level = min(level, ribbon.level)
+    push = pushed_to_finest(level, ribbon.level)
+    change = damped_change(ribbon, np.arange(len(backbone)), push, wanted)
+    return model.plan(segment, ribbon.points + push @ change)
+
+
+def _inside(density: DensityMap, coords: np.ndarray) -> np.ndarray:
+    """Whether each of ``coords`` lies inside the map's grid."""
+    index = (coords - density.origin) @ np.linalg.inv(density.axes)
+    return np.all((index >= 0) & (index <= np.array(density.values.shape) - 1), axis=1)
