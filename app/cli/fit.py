@@ -1,28 +1,34 @@
-"""The headless ``fit`` and ``morph`` commands: a model moved onto another conformation, coarse
-to fine, with the wavelet levels as the unknowns (:mod:`core.fitting`)."""
+"""The headless ``fit`` and ``morph`` commands: a model moved onto another conformation or into
+a density map, coarse to fine, with the wavelet levels as the unknowns (:mod:`core.fitting`)."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from app.arguments import bounded
 from app.cli.structure import chain_segments, load, model_argument
 from app.errors import InputError
 from core.analysis.compare import PAIRINGS
 from core.analysis.superpose import superpose
 from core.fitting.coarse_to_fine import Pairs
-from core.fitting.conformation import SAME_FOLD, ConformationFit, fit_conformation, fold_similarity, pair_segments
+from core.fitting.conformation import SAME_FOLD, fit_conformation, fold_similarity, pair_segments
+from core.fitting.density import RESOLUTION, MapTarget, fit_map, heavy_atoms
 from core.fitting.morph import morph_frames
+from core.fitting.settle import FitResult
 from core.geometry.validation import validate
 from core.protein.model import EditableModel
 from core.protein.structure import Structure, ca_rows
 from core.protein.writing import write_models
+from core.surfaces.volume import MapError, read_map
 
 DEFAULT_LEVELS = (0, 6)
+MAP_SUFFIXES = (".ccp4", ".mrc", ".map")
 MAX_FRAMES = 1000
 CHECKED = (("peptide_bond", "bad peptide bonds"), ("ca_ca", "bad Cα–Cα"), ("clash", "clashes"),
            ("ramachandran", "Ramachandran outliers"))
@@ -48,10 +54,15 @@ def _common_arguments(parser: argparse.ArgumentParser) -> None:
 def fit_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, metavar="MODEL", help="structure to move (PDB or mmCIF, optionally gzipped)")
     model_argument(parser)
-    parser.add_argument("--to", required=True, type=Path, metavar="TARGET", help="the structure to move it onto")
+    parser.add_argument("--to", required=True, type=Path, metavar="TARGET",
+                        help="the structure to move it onto (PDB or mmCIF), or a density map to move it into "
+                             "(CCP4/MRC/MAP, optionally gzipped)")
     parser.add_argument("--chain", metavar="ID", help="chain of MODEL to fit (default: its first protein chain)")
     parser.add_argument("--target-chain", metavar="ID", help="chain of TARGET (default: its first protein chain)")
     _common_arguments(parser)
+    parser.add_argument("--resolution", type=bounded(float, *RESOLUTION), metavar="Å",
+                        help="for a map target (CCP4/MRC/MAP): its resolution, which the model's density is "
+                             f"simulated at ({RESOLUTION[0]:g} to {RESOLUTION[1]:g} Å)")
     parser.add_argument("--no-regularize", dest="regularize", action="store_false",
                         help="leave the residues as the fit remaps them (peptide junctions may stretch)")
     parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
@@ -60,41 +71,90 @@ def fit_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_fit(args: argparse.Namespace) -> int:
-    model_structure, target = load(args.file, args.model), load(args.to)
-    model, pairs, pairing, rows = _paired(model_structure, args.chain, target, args.target_chain, args.pairing)
-    before = validate(model_structure, model.coords).counts
-    result = _fit(model, pairs, args.levels, args.regularize)
-    fits = result.levels
-    after = validate(model_structure, model.coords).counts
-    rmsd = superpose(model.coords[rows], np.concatenate([p.target for p in pairs])).rmsd
+    structure = load(args.file, args.model)
+    model = EditableModel(structure)
+    before = validate(structure, model.coords).counts
+    result, report, measure, score = (_fit_map if _is_map(args.to) else _fit_structure)(model, args)
+    after = validate(structure, model.coords).counts
+    final = report["final"] = round(score(), 4)
     try:
         written = model.save(args.output, overwrite=args.overwrite)
     except FileExistsError as error:
         raise InputError(f"{error} (pass --overwrite to replace it)") from None
     except (ValueError, OSError) as error:
         raise InputError(str(error)) from None
-    report = {
-        "model": str(args.file), "target": str(args.to), "pairing": pairing,
-        "pairs": sum(len(p.residues) for p in pairs),
-        "levels": [{"level": f.level, "control_points": f.control_points, "rmsd": round(f.score, 4),
-                    "seconds": round(f.seconds, 4)} for f in fits],
-        "dropped_levels": result.dropped, "regularized": args.regularize, "rmsd": round(rmsd, 4),
+    what = report.pop("what")
+    report.update({
+        "model": str(args.file), "target": str(args.to),
+        "levels": [{"level": f.level, "control_points": f.control_points, measure: round(f.score, 4),
+                    "seconds": round(f.seconds, 4)} for f in result.levels],
+        "dropped_levels": result.dropped, "regularized": args.regularize,
         "validation": {kind: {"before": before[kind], "after": after[kind]} for kind, _ in CHECKED},
         "output": str(written),
-    }
+    })
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
-    print(f"{report['pairs']} residue pairs ({pairing}); Cα rmsd to the target after each level:")
-    for f in fits:
-        print(f"  level {f.level}: {f.control_points:4d} control points, Cα rmsd {f.score:6.3f} Å, {f.seconds:6.2f} s")
+    name, unit = ("Cα rmsd", " Å") if measure == "rmsd" else ("correlation", "")
+    print(f"{what}; {name} after each level:")
+    for f in result.levels:
+        print(f"  level {f.level}: {f.control_points:4d} control points, {name} {f.score:6.3f}{unit}, {f.seconds:6.2f} s")
     if result.dropped:
         print(f"  levels {', '.join(map(str, result.dropped))} undone: the regularized model kept more bad peptide "
               "junctions than the input (the target's backbone differs at that detail)")
     done = "regularized" if args.regularize else "not regularized"
-    print(f"{done}: Cα rmsd {rmsd:.3f} Å; " + ", ".join(f"{before[k]} -> {after[k]} {name}" for k, name in CHECKED))
+    print(f"{done}: {name} {final:.3f}{unit}; " + ", ".join(f"{before[k]} -> {after[k]} {label}" for k, label in CHECKED))
     print(f"wrote {written}")
     return 0
+
+
+def _is_map(path: Path) -> bool:
+    name = path.name.lower().removesuffix(".gz")
+    return name.endswith(MAP_SUFFIXES)
+
+
+Fitted = tuple[FitResult, dict, str, Callable[[], float]]
+"""A settled fit, the report so far, the name of its score, and the score of the model now."""
+
+
+def _fit_structure(model: EditableModel, args: argparse.Namespace) -> Fitted:
+    if args.resolution is not None:
+        raise InputError("--resolution is for a map target; TARGET is a structure")
+    target = load(args.to)
+    pairs, pairing, rows = _paired(model, args.chain, target, args.target_chain, args.pairing)
+    result = _settled(lambda levels: fit_conformation(model, pairs, levels, regularize=args.regularize), args.levels)
+    report = {"pairing": pairing, "pairs": int(len(rows)), "what": f"{len(rows)} residue pairs ({pairing})"}
+    return result, report, "rmsd", lambda: superpose(model.coords[rows], np.concatenate([p.target for p in pairs])).rmsd
+
+
+def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
+    if args.resolution is None:
+        raise InputError("a map target needs --resolution (Å), the resolution to simulate the model's density at")
+    if args.target_chain is not None or args.pairing != "auto":
+        raise InputError("--target-chain and --pairing are for a structure target; TARGET is a map")
+    structure = model.structure
+    segments = chain_segments(structure, structure.segments[0].chain if args.chain is None else args.chain) \
+        if structure.segments else []
+    if not segments:
+        raise InputError(f"{structure.path}: no protein chain to fit")
+    try:
+        density = read_map(args.to)
+        target = MapTarget(density, args.resolution, model.coords[heavy_atoms(model)])
+    except (MapError, ValueError) as error:
+        raise InputError(str(error)) from None
+    result = _settled(lambda levels: fit_map(model, segments, target, levels, regularize=args.regularize),
+                      args.levels)
+    rows = heavy_atoms(model)
+    report = {"resolution": args.resolution, "segments": len(segments),
+              "what": f"{len(segments)} segment(s) into the map at {args.resolution:g} Å"}
+    return result, report, "cc", lambda: target.correlation(model.coords[rows])
+
+
+def _settled(fit: Callable[[range], FitResult], bounds: tuple[int, int]) -> FitResult:
+    try:
+        return fit(range(bounds[0], bounds[1] + 1))
+    except ValueError as error:
+        raise InputError(str(error)) from None
 
 
 def morph_arguments(parser: argparse.ArgumentParser) -> None:
@@ -114,8 +174,9 @@ def run_morph(args: argparse.Namespace) -> int:
         raise InputError(f"--frames must be between 1 and {MAX_FRAMES}; got {args.frames}")
     chain_a, chain_b = _chains(args.chains)
     start = load(args.file_a)
-    model, pairs, pairing, _ = _paired(start, chain_a, load(args.file_b), chain_b, args.pairing)
-    fits = _fit(model, pairs, args.levels, regularize=False).levels
+    model = EditableModel(start)
+    pairs, pairing, _ = _paired(model, chain_a, load(args.file_b), chain_b, args.pairing)
+    fits = _settled(lambda levels: fit_conformation(model, pairs, levels, regularize=False), args.levels).levels
     frames = morph_frames(EditableModel(start), fits, args.frames)
     try:
         written = write_models(start, frames, args.output, overwrite=args.overwrite)
@@ -139,16 +200,16 @@ def _chains(text: str | None) -> tuple[str | None, str | None]:
 
 
 def _paired(
-    structure: Structure, chain: str | None, target: Structure, target_chain: str | None, pairing: str
-) -> tuple[EditableModel, list[Pairs], str, np.ndarray]:
-    """The model of ``structure``, its chain's residues paired with the target chain's, the
-    pairing used and the Cα rows of the paired residues."""
+    model: EditableModel, chain: str | None, target: Structure, target_chain: str | None, pairing: str
+) -> tuple[list[Pairs], str, np.ndarray]:
+    """The residues of the model's chain paired with the target chain's, the pairing used
+    and the Cα rows of the paired residues."""
+    structure = model.structure
     if not structure.segments or not target.segments:
         missing = structure if not structure.segments else target
         raise InputError(f"{missing.path}: no protein chain to fit")
     numbers = chain_segments(structure, structure.segments[0].chain if chain is None else chain)
     target_numbers = chain_segments(target, target.segments[0].chain if target_chain is None else target_chain)
-    model = EditableModel(structure)
     try:
         pairs, used = pair_segments(model, numbers, [target.segments[k] for k in target_numbers], pairing)
     except ValueError as error:
@@ -161,11 +222,4 @@ def _paired(
                          f"{sum(len(p.residues) for p in pairs)} {used}-paired residues): nothing to fit onto")
     ca = ca_rows(structure)
     rows = np.concatenate([ca[structure.segments[p.segment].residue_index[p.residues]] for p in pairs])
-    return model, pairs, used, rows
-
-
-def _fit(model: EditableModel, pairs: list[Pairs], bounds: tuple[int, int], regularize: bool) -> ConformationFit:
-    try:
-        return fit_conformation(model, pairs, range(bounds[0], bounds[1] + 1), regularize=regularize)
-    except ValueError as error:
-        raise InputError(str(error)) from None
+    return pairs, used, rows

@@ -5,17 +5,15 @@ after a drag, keeping the finest level whose regularized model has no new bad ju
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from core.analysis.compare import pair_residues
 from core.analysis.fold_alignment import tm_superpose
-from core.fitting.coarse_to_fine import LevelFit, Pairs, fit_levels
-from core.geometry.regularize import regularized
-from core.geometry.validation import validate
-from core.protein.model import Edit, EditableModel
-from core.protein.structure import BackboneSegment, Structure, ca_rows
+from core.fitting.coarse_to_fine import Pairs, fit_levels
+from core.fitting.settle import FitResult, settle
+from core.protein.model import EditableModel
+from core.protein.structure import BackboneSegment, ca_rows
 
 
 def pair_segments(
@@ -48,28 +46,6 @@ def fold_similarity(model: EditableModel, pairs: Sequence[Pairs]) -> float:
     return tm_superpose(ca, np.concatenate([p.target for p in pairs]), length)[1]
 
 
-@dataclass(frozen=True, eq=False)
-class ConformationFit:
-    """The result of :func:`fit_conformation`.
-
-    Attributes
-    ----------
-    levels : the fit of each level kept, coarse first (their edits applied to the model).
-    regularization : the regularizing edit of each segment, after the levels.
-    dropped : levels fitted but undone: the regularized model of each left more bad
-        peptide junctions than the input had (finer levels bent the backbone to a shape
-        its residues cannot take, as when the target is another protein).
-    """
-
-    levels: list[LevelFit]
-    regularization: list[Edit]
-    dropped: list[int]
-
-
-BACKBONE = ("peptide_bond", "ca_ca")
-"""The flags a regularized fit may not add."""
-
-
 def fit_conformation(
     model: EditableModel,
     pairs: Sequence[Pairs],
@@ -77,45 +53,8 @@ def fit_conformation(
     *,
     regularize: bool = True,
     cancelled: Callable[[], bool] = lambda: False,
-) -> ConformationFit:
-    """Fit ``model`` onto the paired target Cα at ``levels`` (coarse first) and, with
-    ``regularize``, regularize the residues that moved; every edit kept is applied to
-    ``model``. A finest level whose regularized model has more bad peptide junctions than
-    the input is undone (and so on down)."""
+) -> FitResult:
+    """Fit ``model`` onto the paired target Cα at ``levels`` (coarse first), then
+    :func:`~core.fitting.settle.settle` it; every edit kept is applied to ``model``."""
     fits = list(fit_levels(model, pairs, levels, ca_rows(model.structure), cancelled=cancelled))
-    if not regularize:
-        return ConformationFit(fits, [], [])
-    allowed = _bad_junctions(model.structure, model.structure.coords)
-    dropped: list[int] = []
-    while True:
-        edits = regularize_fit(model, fits)
-        if len(fits) <= 1 or _bad_junctions(model.structure, model.coords) <= allowed or cancelled():
-            return ConformationFit(fits, edits, dropped)
-        for edit in reversed(edits):
-            model.revert(edit)
-        for edit in reversed(fits[-1].edits):
-            model.revert(edit)
-        dropped.insert(0, fits.pop().level)
-
-
-def _bad_junctions(structure: Structure, coords: np.ndarray) -> int:
-    counts = validate(structure, coords).counts
-    return sum(counts[kind] for kind in BACKBONE)
-
-
-def regularize_fit(model: EditableModel, fits: Sequence[LevelFit]) -> list[Edit]:
-    """Regularize (and apply) what ``fits`` moved, one edit per segment: ideal peptide
-    junctions, on the fitted curve, without new clashes (:func:`core.geometry.regularize.regularized`)."""
-    total: dict[int, Edit] = {}
-    for fit in fits:
-        for edit in fit.edits:
-            total[edit.segment] = total[edit.segment].then(edit) if edit.segment in total else edit
-    edits = []
-    for edit in total.values():
-        if len(edit.residues):
-            fixed = regularized(model, edit)
-            step = Edit(edit.segment, edit.new_points, edit.new_points, fixed.residues, fixed.rows,
-                        model.coords[fixed.rows], fixed.new_coords)  # from the fitted state
-            model.apply(step)
-            edits.append(step)
-    return edits
+    return settle(model, fits, regularize=regularize, cancelled=cancelled)

@@ -7,11 +7,11 @@ computed on an orthogonal grid by spreading the atoms trilinearly and blurring w
 around the model. The objective is their correlation about the mean (CC), whose gradient
 with respect to every atom is the blurred derivative field interpolated at the atom.
 
-At each level the model follows a preconditioned gradient ascent: the CC's gradient summed
-over each residue's atoms asks each residue to move a little; the level's control points
-take the damped least-squares change that moves the residue points so (as in
-:mod:`core.fitting.coarse_to_fine`); the residues are remapped exactly and the step is kept if
-the CC rose, growing the next step, or undone and halved.
+At each level the unknowns are the level's control points of every fitted segment, as in
+:mod:`core.fitting.coarse_to_fine`; L-BFGS maximises the CC less the energy of an elastic
+network of the Cα (which keeps the chain from molding itself into any density), each
+evaluation remapping the residues exactly, the gradient taking each residue's atoms to
+move with its curve point (the turn of its frame left out).
 """
 
 from __future__ import annotations
@@ -20,11 +20,12 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, optimize
 from scipy.spatial import cKDTree
 
 from core.curves.splines import spline_space
-from core.fitting.coarse_to_fine import LevelFit, damped_change, pushed_to_finest
+from core.fitting.coarse_to_fine import LevelFit, pushed_to_finest
+from core.fitting.settle import FitResult, settle
 from core.protein.model import Edit, EditableModel
 from core.protein.structure import ca_rows
 from core.surfaces.volume import DensityMap, MapError
@@ -35,11 +36,7 @@ RESOLUTION = (2.0, 30.0)
 """Å: the resolutions a fit takes."""
 MIN_OVERLAP = 0.5
 """Fewest of the model's atoms that must lie inside the map."""
-FIRST_STEP = 0.25
-"""Largest residue move of a level's first step, in units of the resolution."""
-SMALLEST_STEP = 0.02
-"""Å: a level ends when its step has shrunk below this."""
-STEPS_PER_LEVEL = 100
+ITERATIONS_PER_LEVEL = 60
 STIFFNESS = 0.003
 """CC per Å² of mean squared change of the elastic network's spring lengths."""
 ELASTIC_CUTOFF = 10.0
@@ -169,9 +166,10 @@ def fit_map_levels(
     ca = ca_rows(model.structure)[np.concatenate([model.segments[s].residue_index for s in segments])]
     network = ElasticNetwork(model.coords[ca])
 
-    def objective() -> tuple[float, float, np.ndarray]:
-        cc, gradient = target.gradient(model.coords[rows])
-        energy, pull = network.gradient(model.coords[ca])
+    def evaluate(coords: np.ndarray) -> tuple[float, float, np.ndarray]:
+        """The objective, the CC and the objective's gradient per atom at ``coords``."""
+        cc, gradient = target.gradient(coords[rows])
+        energy, pull = network.gradient(coords[ca])
         total = np.zeros((model.structure.n_atoms, 3))
         total[rows] = gradient
         total[ca] -= stiffness * pull
@@ -181,43 +179,78 @@ def fit_map_levels(
         if cancelled():
             return
         start = time.perf_counter()
-        edits: dict[int, Edit] = {}
-        value, cc, gradient = objective()
-        step = FIRST_STEP * target.resolution
-        for _ in range(STEPS_PER_LEVEL):
-            if step < SMALLEST_STEP or cancelled():
-                break
-            planned = [_step(model, segment, level, gradient, step) for segment in segments]
-            for edit in planned:
-                model.apply(edit)
-            new_value, new_cc, new_gradient = objective()
-            if new_value > value:
-                value, cc, gradient, step = new_value, new_cc, new_gradient, step * 1.5
-                for edit in planned:
-                    edits[edit.segment] = edits[edit.segment].then(edit) if edit.segment in edits else edit
-            else:
-                for edit in reversed(planned):
-                    model.revert(edit)
-                step /= 2.0
+        cc, planned = _fit_level(model, segments, level, lambda coords: evaluate(coords), cancelled)
+        for edit in planned:
+            model.apply(edit)
         n_points = sum(spline_space(min(level, model.ribbons[s].level)).n_points for s in segments)
-        yield LevelFit(level, n_points, cc, time.perf_counter() - start, tuple(edits.values()))
+        yield LevelFit(level, n_points, cc, time.perf_counter() - start, tuple(planned))
 
 
-def _step(model: EditableModel, segment: int, level: int, gradient: np.ndarray, largest: float) -> Edit:
-    """The planned edit of ``segment`` that moves its residues along the objective's gradient
-    (per atom, (n_atoms, 3), summed over each residue), the residue that moves most by ``largest`` Å."""
-    backbone, ribbon = model.segments[segment], model.ribbons[segment]
-    running = np.cumsum(np.vstack([np.zeros((1, 3)), gradient]), axis=0)
-    sums = running[backbone.atom_stop] - running[backbone.atom_start]
-    size = np.linalg.norm(sums, axis=1).max()
-    wanted = sums * (largest / size) if size > 0 else sums
-    level = min(level, ribbon.level)
-    push = pushed_to_finest(level, ribbon.level)
-    change = damped_change(ribbon, np.arange(len(backbone)), push, wanted)
-    return model.plan(segment, ribbon.points + push @ change)
+def _fit_level(model: EditableModel, segments: Sequence[int], level: int,
+               evaluate: Callable[[np.ndarray], tuple[float, float, np.ndarray]],
+               cancelled: Callable[[], bool]) -> tuple[float, list[Edit]]:
+    """Maximise the objective over the level-``level`` control points of ``segments``
+    (L-BFGS; the gradient leaves out the turn of the residue frames). Returns the CC and
+    the planned edits (not applied)."""
+    ribbons = [model.ribbons[s] for s in segments]
+    pushes = [pushed_to_finest(min(level, r.level), r.level) for r in ribbons]
+    designs = [(r.space.design_matrix(r.residue_u) @ push) for r, push in zip(ribbons, pushes)]
+    sizes = [push.shape[1] * 3 for push in pushes]
+    best: dict = {"value": -np.inf}
+
+    def plans(x: np.ndarray) -> list[Edit]:
+        parts = np.split(x, np.cumsum(sizes)[:-1])
+        return [model.plan(s, r.points + push @ part.reshape(-1, 3))
+                for s, r, push, part in zip(segments, ribbons, pushes, parts)]
+
+    def negative(x: np.ndarray) -> tuple[float, np.ndarray]:
+        if cancelled():
+            raise _Cancelled
+        edits = plans(x)
+        coords = model.coords.copy()
+        for edit in edits:
+            coords[edit.rows] = edit.new_coords
+        value, cc, gradient = evaluate(coords)
+        if value > best["value"]:
+            best.update(value=value, cc=cc, edits=edits)
+        running = np.cumsum(np.vstack([np.zeros((1, 3)), gradient]), axis=0)
+        parts = []
+        for s, design in zip(segments, designs):
+            backbone = model.segments[s]
+            per_residue = running[backbone.atom_stop] - running[backbone.atom_start]
+            parts.append((design.T @ per_residue).ravel())
+        return -value, -np.concatenate(parts)
+
+    try:
+        optimize.minimize(negative, np.zeros(sum(sizes)), jac=True, method="L-BFGS-B",
+                          options={"maxiter": ITERATIONS_PER_LEVEL, "gtol": 1e-9, "ftol": 1e-9})
+    except _Cancelled:
+        pass
+    if "edits" not in best:
+        return evaluate(model.coords)[1], []
+    return best["cc"], best["edits"]
+
+
+class _Cancelled(Exception):
+    """Raised inside the optimiser to stop it."""
 
 
 def _inside(density: DensityMap, coords: np.ndarray) -> np.ndarray:
     """Whether each of ``coords`` lies inside the map's grid."""
     index = (coords - density.origin) @ np.linalg.inv(density.axes)
     return np.all((index >= 0) & (index <= np.array(density.values.shape) - 1), axis=1)
+
+
+def fit_map(
+    model: EditableModel,
+    segments: Sequence[int],
+    target: MapTarget,
+    levels: Sequence[int],
+    *,
+    regularize: bool = True,
+    cancelled: Callable[[], bool] = lambda: False,
+) -> FitResult:
+    """Fit ``model``'s ``segments`` into ``target`` at ``levels`` (coarse first), then
+    :func:`~core.fitting.settle.settle` it; every edit kept is applied to ``model``."""
+    fits = list(fit_map_levels(model, segments, target, levels, cancelled=cancelled))
+    return settle(model, fits, regularize=regularize, cancelled=cancelled)

@@ -5,9 +5,12 @@ from pathlib import Path
 
 import gemmi
 import numpy as np
+import pytest
+from scipy import ndimage
 
 from app.main import main
 from core.analysis.superpose import superpose
+from core.fitting.density import gaussian_sigma
 from core.protein.reading import read_structure
 from core.protein.structure import ca_rows
 
@@ -40,7 +43,7 @@ def test_fit_json_and_refusals(capsys, tmp_path: Path) -> None:
     report = json.loads(text)
     assert status == 0 and report["pairing"] == "numbering" and report["pairs"] == 214
     assert [level["level"] for level in report["levels"]] == list(range(7))
-    assert report["rmsd"] <= 1.5 and report["validation"]["peptide_bond"]["after"] == 0
+    assert report["final"] <= 1.5 and report["validation"]["peptide_bond"]["after"] == 0
     status, _, err = run(capsys, "fit", OPEN, "--to", CLOSED, "-o", out)
     assert status == 1 and "pass --overwrite" in err
     status, _, err = run(capsys, "fit", OPEN, "--to", DATA / "1UBQ.pdb.gz", "-o", tmp_path / "x.pdb")
@@ -66,3 +69,57 @@ def test_morph_refuses_bad_frames_and_chains(capsys, tmp_path: Path) -> None:
     assert status == 1 and "--frames" in err
     status, _, err = run(capsys, "morph", CLOSED, OPEN, "--chains", "A", "-o", tmp_path / "m.pdb")
     assert status == 1 and "X:Y" in err
+
+
+def _simulated_map(structure: Path, resolution: float, path: Path, shift: float = 0.0) -> Path:
+    """A CCP4 map of ``structure``'s heavy atoms blurred to ``resolution`` Å (1 Å grid), its
+    origin moved by ``shift`` Å along x."""
+    atoms = read_structure(structure).atoms
+    coords = atoms.coords[~np.isin(atoms.element, ("H", "D"))]
+    origin = np.floor(coords.min(axis=0)) - 15.0
+    shape = tuple(int(n) for n in np.ceil(coords.max(axis=0) + 15.0 - origin))
+    grid = np.zeros(shape, dtype=np.float32)
+    np.add.at(grid, tuple(np.round(coords - origin).astype(int).T), 1.0)
+    grid = ndimage.gaussian_filter(grid, gaussian_sigma(resolution)).astype(np.float32)
+    ccp4 = gemmi.Ccp4Map()
+    ccp4.grid = gemmi.FloatGrid(grid, gemmi.UnitCell(*shape, 90, 90, 90), gemmi.SpaceGroup("P 1"))
+    ccp4.update_ccp4_header()
+    for word, value in zip((50, 51, 52), origin + [shift, 0.0, 0.0]):
+        ccp4.set_header_float(word, float(value))
+    ccp4.write_ccp4_map(str(path))
+    return path
+
+
+def test_fit_into_a_map_raises_the_correlation_and_nears_the_target(capsys, tmp_path: Path) -> None:
+    density = _simulated_map(OPEN, 10.0, tmp_path / "open.ccp4")
+    out = tmp_path / "fitted.pdb"
+    status, text, _ = run(capsys, "fit", CLOSED, "--to", density, "--resolution", "10", "--levels", "0-5",
+                          "-o", out, "--json")
+    report = json.loads(text)
+    assert status == 0 and report["resolution"] == 10.0
+    cc = [level["cc"] for level in report["levels"]]
+    assert cc[-1] > cc[0] and cc[-1] > 0.96 and report["final"] > 0.96
+    fitted = read_structure(out)
+    ca, target = fitted.coords[ca_rows(fitted)], read_structure(OPEN).segments[0].ca
+    start = read_structure(CLOSED).segments[0].ca
+    assert np.sqrt(np.mean(np.sum((ca - target) ** 2, axis=1))) < 0.5 * np.sqrt(np.mean(np.sum((start - target) ** 2,
+                                                                                                axis=1)))
+    assert report["validation"]["peptide_bond"]["after"] == 0
+
+
+def test_bad_maps_and_resolutions_are_refused(capsys, tmp_path: Path) -> None:
+    density = _simulated_map(OPEN, 10.0, tmp_path / "open.mrc")
+    out = tmp_path / "x.pdb"
+    status, _, err = run(capsys, "fit", CLOSED, "--to", density, "-o", out)
+    assert status == 1 and "--resolution" in err
+    far = _simulated_map(OPEN, 10.0, tmp_path / "far.map", shift=500.0)
+    status, _, err = run(capsys, "fit", CLOSED, "--to", far, "--resolution", "10", "-o", out)
+    assert status == 1 and "does not overlap" in err
+    broken = tmp_path / "broken.ccp4"
+    broken.write_bytes(b"not a map" * 50)
+    status, _, err = run(capsys, "fit", CLOSED, "--to", broken, "--resolution", "10", "-o", out)
+    assert status == 1 and "not a readable CCP4/MRC map" in err
+    with pytest.raises(SystemExit) as exit_:
+        main(["fit", str(CLOSED), "--to", str(density), "--resolution", "0.1", "-o", str(out)])
+    assert exit_.value.code == 2
+    assert "--resolution" in capsys.readouterr().err and not out.exists()
