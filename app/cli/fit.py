@@ -98,12 +98,14 @@ def run_fit(args: argparse.Namespace) -> int:
     name, unit = ("Cα rmsd", " Å") if measure == "rmsd" else ("correlation", "")
     print(f"{what}; {name} after each level:")
     for f in result.levels:
-        print(f"  level {f.level}: {f.control_points:4d} control points, {name} {f.score:6.3f}{unit}, {f.seconds:6.2f} s")
+        print(f"  level {f.level}: {f.control_points:4d} control points, {name} {f.score:6.3f}{unit}, "
+              f"{f.seconds:6.2f} s")
     if result.dropped:
         print(f"  levels {', '.join(map(str, result.dropped))} undone: the regularized model kept more bad peptide "
               "junctions than the input (the target's backbone differs at that detail)")
     done = "regularized" if args.regularize else "not regularized"
-    print(f"{done}: {name} {final:.3f}{unit}; " + ", ".join(f"{before[k]} -> {after[k]} {label}" for k, label in CHECKED))
+    changes = ", ".join(f"{before[k]} -> {after[k]} {label}" for k, label in CHECKED)
+    print(f"{done}: {name} {final:.3f}{unit}; {changes}")
     print(f"wrote {written}")
     return 0
 
