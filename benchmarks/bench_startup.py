@@ -4,11 +4,11 @@ Usage: ``xvfb-run -a python benchmarks/bench_startup.py [STRUCTURE] [--runs N] [
 (default 1UBQ). Each run starts a new Python process that imports the editor, opens the
 structure, shows the window and waits for its first frame; it prints the time spent
 importing, reading and drawing, the total since the process started, and the processor time
-the process used (steadier than the clock on a busy machine). Medians over the runs, after
-one untimed start that compiles the bytecode. ``--against TREE`` (another checkout of
-ribbonwave, e.g. a ``git worktree add`` of an earlier commit) times that tree's editor too,
-its runs taking turns with this tree's so that both see the same load, and prints both
-columns and their ratio.
+the process used: medians over the runs, after one untimed start that compiles the bytecode.
+``--against TREE`` (another checkout of ribbonwave, e.g. a ``git worktree add`` of an earlier
+commit) times that tree's editor too, its runs taking turns with this tree's (each tree
+first every other turn) so that both see the same load, and prints both columns and their
+ratio.
 """
 
 from __future__ import annotations
@@ -78,19 +78,16 @@ def main() -> None:
         env["PYTHONPYCACHEPREFIX"] = str(Path(folder) / "bytecode")
         for tree in trees:
             run(tree, path, env)  # compiles the bytecode and fills matplotlib's font cache: not timed
-        for _ in range(args.runs):
-            for times, tree in zip(runs, trees):
+        for turn in range(args.runs):
+            for times, tree in list(zip(runs, trees))[:: 1 if turn % 2 == 0 else -1]:  # who goes first alternates
                 times.append(run(tree, path, env))
-    medians = [{key: float(np.median([t[key] for t in times])) for key in times[0]} for times in runs]
+    rows = {key: [float(np.median([t[key] for t in times])) for times in runs] for key in runs[0][0]}
     print(f"{path.name}: start-up to the first frame, medians of {args.runs} runs (s)")
-    if args.against is None:
-        for key, value in medians[0].items():
-            print(f"  {key:<15} {value:6.2f}")
-        return
-    print(f"  {'':<15} {'this':>6} {'against':>8} {'ratio':>6}    against: {trees[1]}")
-    for key, value in medians[0].items():
-        other = medians[1][key]
-        print(f"  {key:<15} {value:6.2f} {other:8.2f} {value / other if other else float('nan'):6.2f}")
+    if args.against is not None:
+        print(f"  {'':<15} {'this':>6} {'against':>8} {'ratio':>6}    against: {trees[1]}")
+    for key, values in rows.items():
+        ratio = f" {values[0] / values[1]:6.2f}" if len(values) == 2 and values[1] else ""
+        print(f"  {key:<15} {values[0]:6.2f}" + "".join(f" {value:8.2f}" for value in values[1:]) + ratio)
 
 
 if __name__ == "__main__":
