@@ -6,7 +6,6 @@ from __future__ import annotations
 import functools
 
 import numpy as np
-from scipy import ndimage
 
 # The grids: 18 x 18 cells of 20°, φ from -180 (left) to 180, ψ from 180 (top) to -180.
 # '#' favoured, '+' allowed, '.' outlier. Favoured: the densest cells holding 98% of the
@@ -105,6 +104,8 @@ def nearest_allowed(phi: np.ndarray, psi: np.ndarray, kind: np.ndarray) -> tuple
 def _nearest_allowed_cells() -> np.ndarray:
     """(classes, 180, 180, 2): per class and 2° cell (ψ row from +180 down, φ column from
     -180), the (φ, ψ) centre of the nearest allowed 2° cell, across the periodic wrap."""
+    from scipy import ndimage  # only regularization needs it: validating (and the editor's start) does not
+
     fine = np.repeat(np.repeat(RAMACHANDRAN == OUTLIER, 10, axis=1), 10, axis=2)
     out = np.empty((len(fine), 180, 180, 2))
     for k, outlier in enumerate(fine):

@@ -8,13 +8,15 @@ colouring only asks the cached :class:`~core.surfaces.levelled.LevelledSurface` 
 view with the same triangles as the one on screen is written into the existing VTK arrays;
 any other goes under the same actor. Surfaces are computed from the atoms: after an edit
 the surface is stale until it is recomputed (or the edit undone). The
-:class:`SurfacePanel` dock only reads the layer and calls its mutators.
+:class:`SurfacePanel` dock only reads the layer and calls its mutators. The surface code
+(scikit-image, PyWavelets, ...) is imported with the first surface built, not with the editor.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from concurrent.futures import Future, ThreadPoolExecutor
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyvista as pv
@@ -36,8 +38,10 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 from app.editor.document import Document
 from app.polydata import scalar_style, to_polydata
 from core.protein.structure import Structure
-from core.surfaces.levelled import KINDS, UNITS, LevelledSurface, build_surface
 from core.surfaces.mesh import TriangleMesh
+
+if TYPE_CHECKING:
+    from core.surfaces.levelled import LevelledSurface
 
 KIND_NAMES = {"globe": "Globe", "dna": "DNA cylinder", "ses": "Molecular surface (SES)",
               "remesh": "Remeshed surface", "map": "Density map (from the model)"}
@@ -122,8 +126,8 @@ class SurfaceLayer(QObject):
         self._update()
 
     def set_kind(self, kind: str) -> None:
-        if kind not in KINDS:
-            raise ValueError(f"kind must be one of {', '.join(KINDS)}; got {kind!r}")
+        if kind not in KIND_NAMES:
+            raise ValueError(f"kind must be one of {', '.join(KIND_NAMES)}; got {kind!r}")
         self.kind = kind
         self._update()
 
@@ -170,6 +174,8 @@ class SurfaceLayer(QObject):
         self.updated.emit()
 
     def _build(self) -> None:
+        from core.surfaces.levelled import build_surface  # the surface code loads with the first surface
+
         structure, kind = self.document.structure, self.kind
         coords = self.document.model.coords.copy()
         atoms = dataclasses.replace(structure.atoms, coords=coords)
@@ -332,6 +338,8 @@ class SurfacePanel(QWidget):
             self.figures.setText("\n".join([*self._figures(built.surface), layer.message]).strip())
 
     def _figures(self, surface: LevelledSurface) -> list[str]:
+        from core.surfaces.levelled import UNITS  # loaded by the build of ``surface``
+
         layer = self.layer
         lines = []
         if layer.mesh is not None and layer.visible:

@@ -35,8 +35,6 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 from app.editor.document import Document
 from app.editor.scene import tube
 from app.editor.scene.curves import LevelCurve, SegmentPath
-from core.analysis.compare import pair_by_sequence, tm_score
-from core.analysis.fold_alignment import align_folds, tm_d8
 from core.analysis.superpose import MIN_PAIRS, Superposition, fit_closest
 from core.protein.reading import read_bytes, read_structure
 from core.protein.ribbon import Ribbon, segment_ribbon
@@ -126,6 +124,10 @@ def fit_chain(fixed_ca: np.ndarray, fixed: Sequence[BackboneSegment], moving: Se
     ValueError
         Fewer than 3 residue pairs (chains of fewer than 3 residues).
     """
+    # the pairing and the structural alignment load with the first compared structure, not with the editor
+    from core.analysis.compare import pair_by_sequence, tm_score
+    from core.analysis.fold_alignment import align_folds, tm_d8
+
     moving_ca = np.concatenate([s.ca for s in moving])
     pairs_a, pairs_b, pairing = pair_by_sequence(fixed, moving)
     if pairing == "structure":

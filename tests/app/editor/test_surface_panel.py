@@ -4,6 +4,7 @@ panel, levels and colourings shown in place, stale after edits, failures reporte
 from pathlib import Path
 
 import numpy as np
+import pytest
 import pyvista as pv
 from pytestqt.qtbot import QtBot
 
@@ -12,6 +13,8 @@ from app.editor.docks.surfaces import COLOURING_NAMES, KIND_NAMES, STEPS_PER_LEV
 from app.editor.document import Document
 from app.editor.main_window import MainWindow
 from app.editor.scene.scene import Layer
+from core.surfaces.levelled import KINDS
+from core.surfaces.molecular import COLOURINGS
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 BUILD_TIMEOUT_MS = 120_000
@@ -42,6 +45,17 @@ def _actor_mesh(window: MainWindow) -> pv.PolyData:
 def _view(window: MainWindow) -> np.ndarray:
     window.plotter.render()
     return np.asarray(window.plotter.screenshot(return_img=True), dtype=int)
+
+
+def test_the_panel_offers_every_kind_and_colouring_of_the_surface_code(qtbot: QtBot, ubiquitin: Document) -> None:
+    """The panel names the kinds and colourings itself (the surface code loads with the first
+    surface): the same ones, and it refuses others."""
+    assert set(KIND_NAMES) == set(KINDS)
+    assert set(COLOURING_NAMES) == {None, *COLOURINGS}
+    window = _window(qtbot, ubiquitin)
+    with pytest.raises(ValueError, match="kind must be one of"):
+        window.surface_layer.set_kind("cartoon")
+    assert window.surface_layer.kind == "globe"
 
 
 def test_globe_levels_colourings_and_screenshot(qtbot: QtBot, ubiquitin: Document, tmp_path: Path) -> None:
