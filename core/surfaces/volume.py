@@ -94,8 +94,8 @@ class DensityMap:
     def contour_around(self, value: float, centre: np.ndarray, radius: float) -> TriangleMesh:
         """Isosurface at ``value`` within ``radius`` Å of ``centre`` (Å), as maps are drawn in
         model building: marching cubes on the block of the grid that holds the sphere, the
-        triangles reaching beyond it dropped. Empty where the map does not reach or the block
-        does not cross ``value``."""
+        triangles reaching beyond it dropped (degenerate ones kept: this mesh is for drawing).
+        Empty where the map does not reach or the block does not cross ``value``."""
         centre = np.asarray(centre, dtype=np.float64)
         corners = centre + radius * (2.0 * np.array(list(np.ndindex(2, 2, 2))) - 1.0)
         index = (corners - self.origin) @ np.linalg.inv(self.axes)
@@ -105,12 +105,14 @@ class DensityMap:
         empty = TriangleMesh(np.empty((0, 3)), np.empty((0, 3), dtype=np.int64))
         if min(block.shape) < 2 or not block.min() < value < block.max():
             return empty
-        vertices, faces, _, _ = marching_cubes(block, value, allow_degenerate=False)
+        vertices, faces, _, _ = marching_cubes(block, value, allow_degenerate=True)  # (a third faster)
         vertices = self.origin + (vertices + low) @ self.axes
-        inside = np.sum((vertices - centre) ** 2, axis=1) <= radius**2
+        inside = np.einsum("ij,ij->i", vertices - centre, vertices - centre) <= radius**2
         faces = faces[inside[faces].all(axis=1)]
-        used, faces = np.unique(faces, return_inverse=True)
-        return TriangleMesh(vertices[used], faces.reshape(-1, 3)[:, ::-1]) if len(used) else empty
+        used = np.zeros(len(vertices), dtype=bool)
+        used[faces] = True
+        renumbered = np.cumsum(used) - 1
+        return TriangleMesh(vertices[used], renumbered[faces[:, ::-1]])
 
 
 def read_map(path: str | os.PathLike[str]) -> DensityMap:
