@@ -102,10 +102,9 @@ class MapPanel(QWidget):
         density = maps.density
         for widget in (self.slider, self.radius, self.colour, self.resolution):
             widget.setEnabled(density is not None)
-        with QSignalBlocker(self.slider), QSignalBlocker(self.radius), QSignalBlocker(self.resolution):
+        with QSignalBlocker(self.slider), QSignalBlocker(self.radius):
             self.slider.setValue(round(maps.sigma * SIGMA_STEPS))
             self.radius.setValue(maps.radius)
-            self.resolution.setValue(self.correlation.resolution)
         self.colour.setStyleSheet(f"background-color: {QColor(*maps.colour).name()}")
         if density is None:
             self.file_text.setText(NO_MAP)
@@ -118,6 +117,8 @@ class MapPanel(QWidget):
 
     def _show_correlation(self) -> None:
         correlation = self.correlation
+        with QSignalBlocker(self.resolution):
+            self.resolution.setValue(correlation.resolution)  # (set by a script, too)
         if correlation.value is not None:
             self.cc_text.setText(f"Correlation of the edited segment: <b>{correlation.value:.3f}</b>")
         else:

@@ -156,7 +156,8 @@ def test_fit_to_map_coarse_to_fine_is_one_step_a_level_and_a_regularization(wind
     target = read_structure(DATA / OPEN)
     target_ca = target.coords[ca_rows(target)]
     rmsd, cc = _ca_rmsd(window, target_ca), window.rw.map_correlation
-    fitted = window.rw.fit_to_map()
+    fitted = window.rw.fit_to_map(resolution=8.5)
+    assert window.map_panel.resolution.value() == 8.5
     assert [level for level, _ in fitted] == [0, 1, 2, 3]
     steps, index = window.rw.history()
     assert index == 5 and [s.split(" (")[0] for s in steps[:4]] == [f"Fit to map at level {k}" for k in range(4)]
