@@ -321,6 +321,11 @@ class Document(QObject):
         if not np.array_equal(edit.old_coords, edit.new_coords):
             self.undo_stack.push(EditCommand(self, edit, f"Regularize {self.residue_range(edit.residues)}"))
 
+    def push_applied(self, edit: Edit, text: str) -> None:
+        """Make ``edit``, which a fit already applied to the model, one undo step named ``text``."""
+        self._model.revert(edit)
+        self.undo_stack.push(EditCommand(self, edit, text))
+
     def apply_edit(self, edit: Edit) -> None:
         """Carry out ``edit`` (undo commands call this)."""
         self._model.apply(edit)

@@ -50,6 +50,7 @@ from app import EXAMPLES_DIR
 from app.editor import help
 from app.editor.docks.comparison import ComparisonPanel
 from app.editor.docks.console import PythonConsole
+from app.editor.docks.map_panel import MapPanel
 from app.editor.docks.panels import DisplayPanel, RibbonDimensionPanel
 from app.editor.docks.ramachandran import RamachandranPanel
 from app.editor.docks.sequence import SequenceBar
@@ -58,19 +59,24 @@ from app.editor.docks.validation import ValidationPanel
 from app.editor.document import Document
 from app.editor.drag import CLICK_PIXELS, DragController, Mode, PointerEvent
 from app.editor.export_image import ExportImageDialog, render_view, write_png
+from app.editor.fitting import compared_target, levels_to_fit, map_target, run_fit
 from app.editor.identify import Hit, describe, identify
 from app.editor.live_validation import LiveValidation
+from app.editor.map_correlation import LiveCorrelation
 from app.editor.persistence import journal, records, session
 from app.editor.picking import PRIORITY, PointerAdapter
+from app.editor.scene.map_mesh import MapMesh
 from app.editor.scene.molecule import Colouring
-from app.editor.scene.overlay import Comparison, ComparisonView
+from app.editor.scene.overlay import Compared, Comparison, ComparisonView
 from app.editor.scene.scene import Layer, Scene
 from app.editor.scene.validation_markers import ValidationMarkers
 from app.editor.scene.view import View
 from app.editor.scripting import EditorAPI
+from core.fitting.coarse_to_fine import LevelFit
 from core.geometry.validation import Flag
 from core.protein.lookup import find_residues
 from core.protein.structure import StructureError
+from core.surfaces.volume import MapError
 
 APP_NAME = "ribbonwave"
 RECENT_KEY = "recentFiles"
@@ -83,6 +89,7 @@ STRUCTURE_FILTER = "Structures (*.pdb *.ent *.cif *.mmcif *.gz);;All files (*)"
 SAVE_FILTERS = {"PDB (*.pdb *.pdb.gz *.ent)": ".pdb", "mmCIF (*.cif *.cif.gz *.mmcif)": ".cif"}
 SAVE_SUFFIXES = (".pdb", ".ent", ".cif", ".mmcif", ".pdb.gz", ".ent.gz", ".cif.gz", ".mmcif.gz")
 SESSION_FILTER = f"ribbonwave sessions (*{session.SUFFIX});;All files (*)"
+MAP_FILTER = "Density maps (*.ccp4 *.mrc *.map *.gz);;All files (*)"
 
 
 class MainWindow(QMainWindow):
@@ -125,6 +132,10 @@ class MainWindow(QMainWindow):
         self.validation_panel.flagActivated.connect(self.show_flag)
         self.surface_layer = SurfaceLayer(self.document, self.plotter)  # after the scene, which clears the view on load
         self.surface_panel = SurfacePanel(self.surface_layer)
+        self.maps = MapMesh(self.document, self.plotter)  # after the scene, which clears the view on load
+        self.correlation = LiveCorrelation(self.document, self.maps)
+        self._create_fit_actions()
+        self.map_panel = MapPanel(self.maps, self.correlation, self.fit_actions)
         self.history = QUndoView(self.document.undo_stack)
         self.history.setEmptyLabel("<structure as read>")
         self.rw = EditorAPI(self)
@@ -139,7 +150,8 @@ class MainWindow(QMainWindow):
         tabs = [self._dock("Display", _scrolled(self.display_panel)), self._dock("Surface", self.surface_panel),
                 self._dock("Validation", _scrolled(self.validation_panel)),
                 self._dock("Ramachandran", _scrolled(self.ramachandran_panel)),
-                self._dock("Compare", self.comparison_panel), self._dock("History", self.history)]
+                self._dock("Compare", self.comparison_panel), self._dock("Map", _scrolled(self.map_panel)),
+                self._dock("History", self.history)]
         for dock in tabs[1:]:  # one group of tabs under the level controls: each gets the column's height
             self.tabifyDockWidget(tabs[0], dock)
         tabs[0].raise_()
@@ -160,6 +172,10 @@ class MainWindow(QMainWindow):
         self.document.picked.connect(self._update_status)
         self.document.selectionChanged.connect(self._update_status)
         self.document.picked.connect(self._update_regularize_action)
+        for signal in (self.document.loaded, self.maps.changed, self.comparison.changed):
+            signal.connect(self._update_fit_actions)
+        self.correlation.updated.connect(self._update_correlation)
+        self._update_fit_actions()
         self._update_title()
         self._update_status()
         self._restore_layout()
@@ -342,6 +358,50 @@ class MainWindow(QMainWindow):
         """Centre the view on ``flag``'s marker and select its residues (see :meth:`select_and_centre`)."""
         self.select_and_centre(np.array(flag.residues, dtype=np.int64), np.array(flag.position))
 
+    def open_map(self, path: Path, *, raise_errors: bool = False) -> bool:
+        """Show the density map at ``path`` (CCP4/MRC, optionally gzipped); a bad file is
+        reported in a dialog (or raised as MapError with ``raise_errors``)."""
+        try:
+            self.maps.open(Path(path))
+        except MapError as error:
+            if raise_errors:
+                raise
+            QMessageBox.critical(self, APP_NAME, str(error))
+            return False
+        return True
+
+    def fit(self, target: str, coarse_to_fine: bool, levels: list[int] | None = None, *,
+            raise_errors: bool = False) -> list[LevelFit]:
+        """Fit the edited segment to the ``'map'`` or the ``'compared'`` structure (the first
+        shown) at ``levels`` (default: the level shown, or coarse to fine every level up to it),
+        each level one undo step (see :mod:`app.editor.fitting`). Returns the levels fitted;
+        what prevents a fit is said in a dialog (or raised as ValueError with ``raise_errors``)."""
+        document = self.document
+        try:
+            if not document.editable:
+                raise ValueError(document.read_only_reason or "no structure is open")
+            if target == "map":
+                if self.maps.density is None:
+                    raise ValueError("no map is open: File ▸ Open Map… first")
+                fit_target = map_target(document, self.maps.density, self.correlation.resolution)
+            else:
+                fit_target = compared_target(document, self._compared())
+        except ValueError as error:  # MapError included
+            if raise_errors:
+                raise
+            QMessageBox.critical(self, APP_NAME, str(error))
+            return []
+        if levels is None:
+            levels = levels_to_fit(document, coarse_to_fine)
+        return run_fit(document, fit_target, levels, self)
+
+    def _compared(self) -> Compared:
+        """The compared structure fits go to: the first shown (else the first)."""
+        items = self.comparison.items
+        if not items:
+            raise ValueError("no compared structure: File ▸ Add Structures for Comparison… first")
+        return next((item for item in items if item.visible), items[0])
+
     # ------------------------------------------------------------------ events
 
     def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802 (Qt override)
@@ -419,6 +479,30 @@ class MainWindow(QMainWindow):
             action.setChecked(mode is self.controller.mode)
             self.mode_actions.addAction(action)
 
+    def _create_fit_actions(self) -> None:
+        self.open_map_action = self._action("Open &Map…", QKeySequence("Ctrl+Shift+M"), self._open_map_dialog)
+        self.open_map_action.setToolTip("Read a CCP4 or MRC density map and draw it around the view's centre")
+        self.fit_actions = [
+            self._action(text, QKeySequence(), lambda _=False, t=target, c=coarse: self.fit(t, c))
+            for target, name in (("map", "Map"), ("compared", "Compared Structure"))
+            for coarse, text in ((False, f"Fit to {name} at This Level"), (True, f"Fit to {name} Coarse to Fine"))
+        ]
+        for action in self.fit_actions:
+            action.setToolTip("Move the edited segment's control points " + (
+                "at every level from 0 up to the one shown, coarse first, then regularize; each level one undo step"
+                if "Coarse" in action.text() else "at the level shown (one undo step)"))
+
+    def _update_fit_actions(self) -> None:
+        editable = self.document.editable
+        for action in self.fit_actions[:2]:
+            action.setEnabled(editable and self.maps.density is not None)
+        for action in self.fit_actions[2:]:
+            action.setEnabled(editable and bool(self.comparison.items))
+
+    def _update_correlation(self) -> None:
+        value = self.correlation.value
+        self.status_labels["map"].setText("" if value is None else f"map CC {value:.3f}")
+
     def _action(self, text: str, shortcut: QKeySequence | QKeySequence.StandardKey, slot: object,
                 icon: object = None) -> QAction:
         action = QAction(text, self)
@@ -436,6 +520,7 @@ class MainWindow(QMainWindow):
         self.recent_menu = file_menu.addMenu("Open &Recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
         file_menu.addAction("Add Structures for &Comparison…", self.comparison_panel.add_dialog)
+        file_menu.addAction(self.open_map_action)
         file_menu.addSeparator()
         file_menu.addActions([self.save_action, self.save_as_action, self.export_action])
         file_menu.addSeparator()
@@ -448,6 +533,8 @@ class MainWindow(QMainWindow):
         edit_menu.addActions(self.mode_actions.actions())
         edit_menu.addSeparator()
         edit_menu.addAction(self.regularize_action)
+        edit_menu.addSeparator()
+        edit_menu.addActions(self.fit_actions)
         view_menu = menu.addMenu("&View")
         view_menu.addActions([self.reset_view_action, self.go_to_action])
         view_menu.addSeparator()
@@ -479,7 +566,7 @@ class MainWindow(QMainWindow):
         toolbar.addWidget(self.go_to_field)
 
     def _create_status_bar(self) -> None:
-        self.status_labels = {key: QLabel() for key in ("file", "segment", "level", "pick", "hover")}
+        self.status_labels = {key: QLabel() for key in ("file", "segment", "level", "pick", "map", "hover")}
         for key, label in self.status_labels.items():
             self.statusBar().addWidget(label, 1 if key == "pick" else 0)
 
@@ -687,6 +774,13 @@ class MainWindow(QMainWindow):
         source = self.document.path
         folder = Path.home() if source is None or source.parent == EXAMPLES_DIR else source.parent
         return folder / f"{source.name.split('.')[0] if source is not None else 'structure'}{ending}"
+
+    def _open_map_dialog(self) -> None:
+        folder = str(self.maps.path.parent if self.maps.path else self.document.path.parent if self.document.path
+                     else Path.home())
+        name, _ = QFileDialog.getOpenFileName(self, "Open Map", folder, MAP_FILTER)
+        if name:
+            self.open_map(Path(name))
 
     def _open_session_dialog(self) -> None:
         folder = str(self.document.path.parent) if self.document.path else str(Path.home())

@@ -8,6 +8,7 @@ written as File ▸ Save writes them. Errors are exceptions, never dialogs.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -119,6 +120,40 @@ class EditorAPI:
         document.preview_tug(float(document.paths[document.segment].residue_u[index]), _vector(delta))
         document.finish_drag(f"Tug curve at {labels[index]} at level {document.shown_level():.2f}")
 
+    def fit_to_map(self, levels: int | Sequence[int] | None = None, resolution: float | None = None
+                   ) -> list[tuple[int, float]]:
+        """Fit the edited segment into the open map as Edit ▸ Fit to Map does: at level ``levels``
+        (an integer), at each of ``levels`` in turn, or (None) coarse to fine from level 0 up to
+        the one shown; each level one undo step, and a fit of more than one level regularized as
+        one more. ``resolution`` (Å) sets the map's resolution first. Returns each level fitted
+        and the correlation after it."""
+        if resolution is not None:
+            self._window.correlation.set_resolution(float(resolution))
+        return self._fit("map", levels)
+
+    def fit_to_compared(self, levels: int | Sequence[int] | None = None) -> list[tuple[int, float]]:
+        """Fit the edited segment onto the (first shown) compared structure as Edit ▸ Fit to
+        Compared Structure does (``levels`` as for :meth:`fit_to_map`). Returns each level
+        fitted and the Cα rmsd to the target after it (Å)."""
+        return self._fit("compared", levels)
+
+    def _fit(self, target: str, levels: int | Sequence[int] | None) -> list[tuple[int, float]]:
+        self._editable
+        chosen = None if levels is None else [int(levels)] if isinstance(levels, (int, np.integer)) else \
+            [int(level) for level in levels]
+        fits = self._window.fit(target, True, chosen, raise_errors=True)
+        return [(fit.level, fit.score) for fit in fits]
+
+    @property
+    def map_correlation(self) -> float | None:
+        """The correlation of the edited segment with the open map (None without a map)."""
+        self._document
+        correlation = self._window.correlation
+        correlation.update()
+        if correlation.message:
+            raise ValueError(correlation.message)
+        return correlation.value
+
     def undo(self) -> None:
         """Undo the last step (as Ctrl+Z)."""
         self._window.undo_action.trigger()
@@ -136,6 +171,11 @@ class EditorAPI:
             self._window.open_session(path, raise_errors=True)
         else:
             self._window.open_file(path, raise_errors=True)
+
+    def open_map(self, path: str | Path) -> None:
+        """Show a density map (CCP4/MRC, optionally gzipped) as File ▸ Open Map… does
+        (raises :class:`core.surfaces.volume.MapError` for a file that is not one)."""
+        self._window.open_map(Path(path), raise_errors=True)
 
     def export(self, path: str | Path, *, overwrite: bool = False) -> Path:
         """Write the structure as edited (PDB or mmCIF by the extension) without making

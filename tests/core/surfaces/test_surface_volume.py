@@ -68,6 +68,19 @@ def test_contours_enclose_the_protein(density: DensityMap) -> None:
         density.contour(1e6)
 
 
+def test_contour_around_a_point_is_the_contour_near_it(density: DensityMap) -> None:
+    value = density.sigma_level(1.0)
+    whole = density.contour(value)
+    centre = read_atoms(DATA / "1UBQ.pdb.gz").coords[300]
+    near = density.contour_around(value, centre, 8.0)
+    assert 0 < near.n_faces < whole.n_faces / 4
+    assert np.all(np.linalg.norm(near.vertices - centre, axis=1) <= 8.0)
+    inner = np.linalg.norm(whole.vertices - centre, axis=1) < 7.0  # every vertex well inside is drawn
+    assert np.min(np.linalg.norm(whole.vertices[inner][:, None] - near.vertices[None], axis=2), axis=1).max() < 1e-4
+    assert density.contour_around(value, centre + 500.0, 8.0).n_faces == 0  # outside the map
+    assert density.contour_around(1e6, centre, 8.0).n_faces == 0  # no density that high
+
+
 def test_bad_map_files(tmp_path: Path) -> None:
     with pytest.raises(MapError, match="no such file"):
         read_map(tmp_path / "missing.ccp4")

@@ -1,0 +1,102 @@
+"""The live correlation of the edited segment with the open map.
+
+The segment's heavy atoms, blurred to the map's resolution, are correlated with the map in
+a box around them (:class:`core.fitting.density.MapTarget`, built again when the segment,
+the map or the resolution changes). Edits (a drag's previews included) ask for a new value;
+it is computed between events, at most every :data:`INTERVAL_MS`.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from PySide6.QtCore import QObject, Qt, QTimer, Signal
+
+from app.editor.document import Document
+from app.editor.scene.map_mesh import MapMesh
+from core.fitting.density import RESOLUTION, MapTarget, heavy_atoms
+from core.surfaces.volume import MapError
+
+INTERVAL_MS = 100
+"""Shortest time between two correlations."""
+DEFAULT_RESOLUTION = 5.0
+"""Å, the map's resolution until it is set."""
+
+
+class LiveCorrelation(QObject):
+    """The map–model correlation (CC) of ``document``'s edited segment with ``maps``' map."""
+
+    updated = Signal()
+    """:attr:`value` or :attr:`message` changed."""
+
+    def __init__(self, document: Document, maps: MapMesh) -> None:
+        super().__init__(document)
+        self.document = document
+        self.maps = maps
+        self.resolution = DEFAULT_RESOLUTION
+        """Å: the model's density is blurred to it (as the fits do)."""
+        self.value: float | None = None
+        """The CC, or None without a map (or where it cannot be computed: see :attr:`message`)."""
+        self.message = ""
+        self.updates = 0
+        """Correlations computed so far."""
+        self._target: tuple[tuple, MapTarget | MapError | None] = ((), None)  # by (structure, segment, map, resolution)
+        self._rows = np.empty(0, dtype=np.int64)
+        self._last = -np.inf
+        self._timer = QTimer(self)
+        self._timer.setSingleShot(True)
+        self._timer.setTimerType(Qt.TimerType.PreciseTimer)
+        self._timer.timeout.connect(self.update)
+        for signal in (document.loaded, document.changed, document.segmentChanged, maps.changed):
+            signal.connect(self._schedule)
+
+    def set_resolution(self, resolution: float) -> None:
+        """The map's resolution, Å (in :data:`core.fitting.density.RESOLUTION`, else ValueError)."""
+        if not RESOLUTION[0] <= resolution <= RESOLUTION[1]:
+            raise ValueError(f"resolution must be in [{RESOLUTION[0]:g}, {RESOLUTION[1]:g}] Å; got {resolution:g}")
+        self.resolution = float(resolution)
+        self.update()
+
+    def update(self) -> None:
+        """Correlate now."""
+        self._timer.stop()
+        self._last = time.perf_counter()
+        value, self.message = None, ""
+        document = self.document
+        if self.maps.density is not None and document.editable:
+            try:
+                target = self._segment_target()
+                value = target.correlation(document.model.coords[self._rows])
+            except MapError as error:
+                self.message = str(error)
+        self.value = value
+        self.updates += 1
+        self.updated.emit()
+
+    def _segment_target(self) -> MapTarget:
+        """The map around the edited segment (raises MapError where the two do not overlap)."""
+        document = self.document
+        key = (document.structure, document.segment, self.maps.density, self.resolution)
+        if self._target[0] != key:
+            segment = document.structure.segments[document.segment]
+            mine = np.zeros(document.structure.n_atoms, dtype=bool)
+            for start, stop in zip(segment.atom_start, segment.atom_stop):
+                mine[start:stop] = True
+            rows = heavy_atoms(document.model)
+            self._rows = rows[mine[rows]]
+            try:
+                self._target = (key, MapTarget(self.maps.density, self.resolution, document.model.coords[self._rows]))
+            except MapError as error:
+                self._target = (key, error)
+        if isinstance(self._target[1], MapError):
+            raise self._target[1]
+        return self._target[1]
+
+    def _schedule(self, *_: object) -> None:
+        if self.maps.density is None:
+            if self.value is not None or self.message:
+                self.update()
+            return
+        if not self._timer.isActive():
+            self._timer.start(int(np.ceil(max(0.0, INTERVAL_MS - 1000.0 * (time.perf_counter() - self._last)))))

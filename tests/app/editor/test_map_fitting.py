@@ -1,0 +1,218 @@
+"""Maps and fits in the editor: File ▸ Open Map draws the map as a mesh around the view's
+centre, the Map dock's contour and radius, the live correlation, and Edit ▸ Fit to Map /
+Fit to Compared Structure at the level shown and coarse to fine, each level one undo step.
+
+The maps are simulated: the open form of adenylate kinase (4AKE), superposed on the closed
+form (1AKE) that the window edits, as a blurred sum of Gaussians, written as CCP4."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import gemmi
+import numpy as np
+import pytest
+from PySide6.QtWidgets import QApplication, QFileDialog, QProgressDialog
+from pytestqt.qtbot import QtBot
+from scipy import ndimage
+
+from app.editor.main_window import MainWindow
+from app.editor.map_correlation import INTERVAL_MS
+from app.editor.scene.map_mesh import RECONTOUR_MS
+from core.analysis.superpose import superpose
+from core.fitting.density import gaussian_sigma
+from core.protein.reading import read_structure
+from core.protein.structure import ca_rows
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+CLOSED, OPEN = "1AKE_adk_closed.pdb.gz", "4AKE_adk_open.pdb.gz"
+RESOLUTION = 8.0
+
+
+def simulated_map(path: Path, resolution: float = RESOLUTION, spacing: float = 1.5) -> Path:
+    """Write the density of 4AKE's heavy atoms, superposed on 1AKE's Cα, at ``resolution`` Å."""
+    closed, target = read_structure(DATA / CLOSED), read_structure(DATA / OPEN)
+    fit = superpose(closed.coords[ca_rows(closed)], target.coords[ca_rows(target)])  # the same 214 residues
+    heavy = target.atoms.element != "H"
+    coords = fit.apply(target.coords[heavy])
+    origin = coords.min(axis=0) - 12.0
+    shape = np.ceil((coords.max(axis=0) + 12.0 - origin) / spacing).astype(int)
+    index = np.round((coords - origin) / spacing).astype(int)
+    values = np.zeros(shape)
+    np.add.at(values, tuple(index.T), 1.0)
+    values = ndimage.gaussian_filter(values, gaussian_sigma(resolution) / spacing).astype(np.float32)
+    ccp4 = gemmi.Ccp4Map()
+    ccp4.grid = gemmi.FloatGrid(values, gemmi.UnitCell(*(shape * spacing), 90, 90, 90), gemmi.SpaceGroup("P1"))
+    ccp4.update_ccp4_header()
+    for word, value in zip((50, 51, 52), origin):  # the origin, in Å
+        ccp4.set_header_float(word, float(value))
+    ccp4.write_ccp4_map(str(path))
+    return path
+
+
+@pytest.fixture(scope="module")
+def adk_map(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return simulated_map(tmp_path_factory.mktemp("maps") / "4AKE_8A.ccp4")
+
+
+@pytest.fixture
+def window(open_window: Callable[[str], MainWindow], adk_map: Path) -> MainWindow:
+    """1AKE with the map of 4AKE open, the map's resolution set."""
+    window = open_window(CLOSED)
+    window.rw.open_map(adk_map)
+    window.map_panel.resolution.setValue(RESOLUTION)
+    return window
+
+
+def _focal_point(window: MainWindow) -> np.ndarray:
+    return np.array(window.plotter.renderer.GetActiveCamera().GetFocalPoint())
+
+
+def _ca_rmsd(window: MainWindow, target: np.ndarray) -> float:
+    document = window.document
+    return superpose(document.model.coords[document.ca_rows], target).rmsd
+
+
+def test_the_map_is_a_mesh_around_the_centre_that_follows_it(window: MainWindow, qtbot: QtBot) -> None:
+    maps = window.maps
+    assert maps.actor is not None and maps.actor.prop.style == "Wireframe"
+    assert maps.mesh.n_cells > 500
+    assert np.array_equal(maps.centre, _focal_point(window))
+    assert np.linalg.norm(maps.mesh.points - maps.centre, axis=1).max() <= maps.radius
+    assert "4AKE_8A.ccp4" in window.map_panel.file_text.text()
+    before, frames = maps.mesh.points.copy(), window.plotter.frames
+    window.go_to("150")  # centres the view on a residue at the edge of the chain
+    qtbot.waitUntil(lambda: np.array_equal(maps.centre, _focal_point(window)))
+    assert not np.array_equal(maps.mesh.points[:10], before[:10])
+    assert np.linalg.norm(maps.mesh.points - maps.centre, axis=1).max() <= maps.radius
+    qtbot.waitUntil(lambda: window.plotter.frames > frames)
+    cells = maps.mesh.n_cells
+    window.map_panel.slider.setValue(25)  # 2.5 σ: less of the map
+    assert maps.sigma == 2.5 and 0 < maps.mesh.n_cells < cells
+    window.map_panel.radius.setValue(8.0)
+    assert np.linalg.norm(maps.mesh.points - maps.centre, axis=1).max() <= 8.0
+
+
+def test_the_centre_is_contoured_at_most_ten_times_a_second(window: MainWindow, qtbot: QtBot) -> None:
+    maps, times = window.maps, []
+    maps.contour()
+    maps.contoured.connect(lambda: times.append(time.perf_counter()))
+    ca = window.document.model.coords[window.document.ca_rows]
+    for k in range(40):  # a fast pan: the centre moves at each of 40 frames within a few milliseconds
+        window.scene.centre_on(ca[5 * k])
+        window.plotter.ren_win.InvokeEvent("StartEvent")
+        QApplication.processEvents()
+    qtbot.waitUntil(lambda: np.array_equal(maps.centre, ca[195]))
+    assert len(times) < 40 and np.all(np.diff(times) >= RECONTOUR_MS / 1e3 - 1e-3)
+
+
+def test_a_broken_map_file_gives_a_dialog(
+    open_window: Callable[[str], MainWindow], tmp_path: Path, errors: list[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    window = open_window(CLOSED)
+    junk = tmp_path / "broken.map"
+    junk.write_bytes(b"not a map" * 200)
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", lambda *args: (str(junk), ""))
+    window.open_map_action.trigger()  # File ▸ Open Map…
+    assert len(errors) == 1 and "not a readable CCP4/MRC map" in errors[0]
+    assert window.maps.density is None and not window.fit_actions[0].isEnabled()
+
+
+def test_the_correlation_shows_and_follows_edits_ten_times_a_second(window: MainWindow, qtbot: QtBot) -> None:
+    correlation, document = window.correlation, window.document
+    qtbot.waitUntil(lambda: correlation.value is not None)
+    assert 0.3 < correlation.value < 0.95
+    assert f"{correlation.value:.3f}" in window.map_panel.cc_text.text()
+    assert window.status_labels["map"].text() == f"map CC {correlation.value:.3f}"
+    qtbot.wait(INTERVAL_MS + 20)
+    before, first = correlation.updates, correlation.value
+    document.pick_point(5)
+    for k in range(30):  # a drag's previews without a turn of the event loop between them
+        document.preview_move(5, np.array([0.2 * k, 0.0, 0.0]))
+    qtbot.waitUntil(lambda: correlation.updates == before + 1)
+    qtbot.wait(2 * INTERVAL_MS)
+    assert correlation.updates == before + 1 and correlation.value != first
+    document.cancel_drag()
+
+
+def test_fit_to_map_at_this_level_is_one_undo_step(window: MainWindow) -> None:
+    document = window.document
+    document.set_level(2)
+    cc = window.rw.map_correlation
+    window.fit_actions[0].trigger()  # Edit ▸ Fit to Map at This Level
+    assert document.undo_stack.count() == 1
+    assert document.undo_stack.text(0).startswith("Fit to map at level 2 (CC ")
+    assert window.rw.map_correlation > cc + 0.05
+    window.rw.undo()
+    assert np.array_equal(document.model.coords, document.structure.coords)
+    assert window.rw.map_correlation == cc
+
+
+def test_fit_to_map_coarse_to_fine_is_one_step_a_level_and_a_regularization(window: MainWindow) -> None:
+    document = window.document
+    document.set_level(3)
+    target = read_structure(DATA / OPEN)
+    target_ca = target.coords[ca_rows(target)]
+    rmsd, cc = _ca_rmsd(window, target_ca), window.rw.map_correlation
+    fitted = window.rw.fit_to_map(resolution=8.5)
+    assert window.map_panel.resolution.value() == 8.5
+    assert [level for level, _ in fitted] == [0, 1, 2, 3]
+    steps, index = window.rw.history()
+    assert index == 5 and [s.split(" (")[0] for s in steps[:4]] == [f"Fit to map at level {k}" for k in range(4)]
+    assert steps[4] == "Regularize the fit to map"
+    assert window.rw.map_correlation > cc + 0.1
+    assert _ca_rmsd(window, target_ca) < rmsd - 2.0  # towards the open form whose map it is
+    for _ in range(5):
+        window.rw.undo()
+    assert np.array_equal(document.model.coords, document.structure.coords)
+
+
+def test_cancel_stops_the_fit_after_the_level_under_way(window: MainWindow, qtbot: QtBot) -> None:
+    document = window.document
+    document.set_level(3)
+
+    def cancel() -> None:
+        dialog = window.findChild(QProgressDialog)
+        if dialog is not None:
+            dialog.cancel()  # Cancel pressed once level 0 is done
+
+    document.undo_stack.indexChanged.connect(cancel)
+    window.fit_actions[1].trigger()  # Edit ▸ Fit to Map Coarse to Fine
+    document.undo_stack.indexChanged.disconnect(cancel)
+    steps, index = window.rw.history()
+    assert index == 1 and steps[0].startswith("Fit to map at level 0")
+    window.rw.undo()
+    assert np.array_equal(document.model.coords, document.structure.coords)
+
+
+def test_fit_to_compared_structure_brings_the_ca_rmsd_down(open_window: Callable[[str], MainWindow]) -> None:
+    window = open_window(CLOSED)
+    assert not window.fit_actions[3].isEnabled()
+    window.comparison.add(DATA / OPEN)
+    target = read_structure(DATA / OPEN)
+    target_ca = target.coords[ca_rows(target)]
+    rmsd = _ca_rmsd(window, target_ca)
+    window.fit_actions[2].trigger()  # at this level (6)
+    assert window.rw.history() == ([window.document.undo_stack.text(0)], 1)
+    assert window.document.undo_stack.text(0).startswith("Fit to 4AKE_adk_open at level 6 (Cα rmsd ")
+    assert _ca_rmsd(window, target_ca) < rmsd / 2
+    window.rw.undo()
+    fitted = window.rw.fit_to_compared()  # coarse to fine, levels 0 to 6
+    assert [level for level, _ in fitted] == list(range(7))
+    steps, index = window.rw.history()
+    assert index == 8 and steps[-1] == "Regularize the fit to 4AKE_adk_open"
+    assert rmsd > 6.0 and _ca_rmsd(window, target_ca) < 1.5
+
+
+def test_fits_need_a_target(open_window: Callable[[str], MainWindow], errors: list[str]) -> None:
+    window = open_window(CLOSED)
+    with pytest.raises(ValueError, match="no map is open"):
+        window.rw.fit_to_map()
+    with pytest.raises(ValueError, match="no compared structure"):
+        window.rw.fit_to_compared()
+    window.comparison.add(DATA / "1UBQ.pdb.gz")  # another protein
+    window.fit("compared", False)
+    assert len(errors) == 1 and "another fold" in errors[0]
+    assert window.document.undo_stack.count() == 0
