@@ -21,8 +21,9 @@ from PySide6.QtWidgets import QApplication, QProgressDialog, QWidget
 from app.editor.document import Document
 from app.editor.scene.overlay import Compared, chain_segments
 from core.fitting.coarse_to_fine import LevelFit, fit_levels
-from core.fitting.conformation import SAME_FOLD, fold_similarity, pair_segments, regularize_fit
+from core.fitting.conformation import SAME_FOLD, fold_similarity, pair_segments
 from core.fitting.density import MapTarget, fit_map_levels, heavy_atoms
+from core.fitting.settle import regularize_fit
 from core.surfaces.volume import DensityMap
 
 Fits = Callable[[Sequence[int], Callable[[], bool]], Iterator[LevelFit]]

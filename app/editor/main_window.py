@@ -15,6 +15,7 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QPoint, QSettings, QSize, Qt
@@ -59,7 +60,6 @@ from app.editor.docks.validation import ValidationPanel
 from app.editor.document import Document
 from app.editor.drag import CLICK_PIXELS, DragController, Mode, PointerEvent
 from app.editor.export_image import ExportImageDialog, render_view, write_png
-from app.editor.fitting import compared_target, levels_to_fit, map_target, run_fit
 from app.editor.identify import Hit, describe, identify
 from app.editor.live_validation import LiveValidation
 from app.editor.map_correlation import LiveCorrelation
@@ -72,11 +72,12 @@ from app.editor.scene.scene import Layer, Scene
 from app.editor.scene.validation_markers import ValidationMarkers
 from app.editor.scene.view import View
 from app.editor.scripting import EditorAPI
-from core.fitting.coarse_to_fine import LevelFit
 from core.geometry.validation import Flag
 from core.protein.lookup import find_residues
 from core.protein.structure import StructureError
-from core.surfaces.volume import MapError
+
+if TYPE_CHECKING:
+    from core.fitting.coarse_to_fine import LevelFit
 
 APP_NAME = "ribbonwave"
 RECENT_KEY = "recentFiles"
@@ -363,7 +364,7 @@ class MainWindow(QMainWindow):
         reported in a dialog (or raised as MapError with ``raise_errors``)."""
         try:
             self.maps.open(Path(path))
-        except MapError as error:
+        except ValueError as error:  # a MapError
             if raise_errors:
                 raise
             QMessageBox.critical(self, APP_NAME, str(error))
@@ -376,6 +377,8 @@ class MainWindow(QMainWindow):
         shown) at ``levels`` (default: the level shown, or coarse to fine every level up to it),
         each level one undo step (see :mod:`app.editor.fitting`). Returns the levels fitted;
         what prevents a fit is said in a dialog (or raised as ValueError with ``raise_errors``)."""
+        from app.editor.fitting import compared_target, levels_to_fit, map_target, run_fit  # loads with the first fit
+
         document = self.document
         try:
             if not document.editable:

@@ -9,14 +9,16 @@ it is computed between events, at most every :data:`INTERVAL_MS`.
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QObject, Qt, QTimer, Signal
 
 from app.editor.document import Document
 from app.editor.scene.map_mesh import MapMesh
-from core.fitting.density import RESOLUTION, MapTarget, heavy_atoms
-from core.surfaces.volume import MapError
+
+if TYPE_CHECKING:
+    from core.fitting.density import MapTarget
 
 INTERVAL_MS = 100
 """Shortest time between two correlations."""
@@ -41,7 +43,7 @@ class LiveCorrelation(QObject):
         self.message = ""
         self.updates = 0
         """Correlations computed so far."""
-        self._target: tuple[tuple, MapTarget | MapError | None] = ((), None)  # by (structure, segment, map, resolution)
+        self._target: tuple[tuple, MapTarget | ValueError | None] = ((), None)  # by (structure, segment, map, resolution)
         self._rows = np.empty(0, dtype=np.int64)
         self._last = -np.inf
         self._timer = QTimer(self)
@@ -53,6 +55,8 @@ class LiveCorrelation(QObject):
 
     def set_resolution(self, resolution: float) -> None:
         """The map's resolution, Å (in :data:`core.fitting.density.RESOLUTION`, else ValueError)."""
+        from core.fitting.density import RESOLUTION  # the fitting code loads with the first map
+
         if not RESOLUTION[0] <= resolution <= RESOLUTION[1]:
             raise ValueError(f"resolution must be in [{RESOLUTION[0]:g}, {RESOLUTION[1]:g}] Å; got {resolution:g}")
         self.resolution = float(resolution)
@@ -68,7 +72,7 @@ class LiveCorrelation(QObject):
             try:
                 target = self._segment_target()
                 value = target.correlation(document.model.coords[self._rows])
-            except MapError as error:
+            except ValueError as error:  # a MapError: the map does not overlap the segment
                 self.message = str(error)
         self.value = value
         self.updates += 1
@@ -76,6 +80,8 @@ class LiveCorrelation(QObject):
 
     def _segment_target(self) -> MapTarget:
         """The map around the edited segment (raises MapError where the two do not overlap)."""
+        from core.fitting.density import MapTarget, heavy_atoms  # the fitting code loads with the first map
+
         document = self.document
         key = (document.structure, document.segment, self.maps.density, self.resolution)
         if self._target[0] != key:
@@ -87,9 +93,9 @@ class LiveCorrelation(QObject):
             self._rows = rows[mine[rows]]
             try:
                 self._target = (key, MapTarget(self.maps.density, self.resolution, document.model.coords[self._rows]))
-            except MapError as error:
+            except ValueError as error:  # a MapError
                 self._target = (key, error)
-        if isinstance(self._target[1], MapError):
+        if isinstance(self._target[1], ValueError):
             raise self._target[1]
         return self._target[1]
 

@@ -26,7 +26,6 @@ from PySide6.QtWidgets import (
 
 from app.editor.map_correlation import LiveCorrelation
 from app.editor.scene.map_mesh import MapMesh
-from core.fitting.density import RESOLUTION
 
 SIGMA_RANGE = (0.2, 5.0)
 """The contour slider's range, σ."""
@@ -59,7 +58,6 @@ class MapPanel(QWidget):
         self.colour = QPushButton()
         self.colour.setToolTip("Colour of the map's mesh")
         self.resolution = QDoubleSpinBox()
-        self.resolution.setRange(*RESOLUTION)
         self.resolution.setSingleStep(0.5)
         self.resolution.setSuffix(" Å")
         self.resolution.setToolTip("The map's resolution: the model's density is blurred to it for the correlation "
@@ -110,6 +108,9 @@ class MapPanel(QWidget):
             self.file_text.setText(NO_MAP)
             self.sigma_text.setText(f"{maps.sigma:.1f} σ")
         else:
+            from core.fitting.density import RESOLUTION  # the fitting code loads with the first map
+
+            self.resolution.setRange(*RESOLUTION)
             grid = " × ".join(map(str, density.values.shape))
             self.file_text.setText(f"{maps.path.name}: {grid} grid points")
             self.sigma_text.setText(f"{maps.sigma:.1f} σ ({maps.value:.3g})")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyvista as pv
@@ -18,7 +19,9 @@ from PySide6.QtCore import QObject, Qt, QTimer, Signal
 
 from app.editor.document import Document
 from app.polydata import to_polydata
-from core.surfaces.volume import DensityMap, read_map
+
+if TYPE_CHECKING:
+    from core.surfaces.volume import DensityMap
 
 DEFAULT_SIGMA = 1.0
 """Contour level, in rms deviations (σ) above the map's mean."""
@@ -67,6 +70,8 @@ class MapMesh(QObject):
     def open(self, path: Path) -> None:
         """Read the CCP4/MRC map at ``path`` (optionally gzipped; raises
         :class:`core.surfaces.volume.MapError`) and draw it instead of the one open."""
+        from core.surfaces.volume import read_map  # the map code (scikit-image, PyWavelets) loads with the first map
+
         self.density, self.path = read_map(path), Path(path)
         self.contour()
         self.changed.emit()

@@ -13,7 +13,7 @@ ROOT = Path(__file__).resolve().parents[3]
 DEFERRED = (
     "skimage", "pywt", "dask", "distributed", "scipy.ndimage", "core.surfaces.levelled", "core.surfaces.molecular",
     "core.surfaces.volume", "core.surfaces.globe", "core.analysis.compare", "core.analysis.fold_alignment",
-    "matplotlib.backends.backend_qtagg", "app.cli",
+    "core.fitting", "app.editor.fitting", "matplotlib.backends.backend_qtagg", "app.cli",
 )  # fmt: skip
 """Modules (and their submodules) that the first window does without."""
 FIRST_WINDOW = """
