@@ -58,12 +58,6 @@ def test_ions_and_ligands() -> None:
     assert len(bonds) >= len(ligands) - 2  # each ADP is connected
 
 
-def test_ca_rows_point_at_the_backbone_ca(ubiquitin) -> None:
-    rows = molecule.ca_rows(ubiquitin)
-    assert np.array_equal(ubiquitin.coords[rows], ubiquitin.segments[0].ca)
-    assert set(ubiquitin.atoms.name[rows]) == {"CA"}
-
-
 def test_colour_schemes(ubiquitin) -> None:
     ss = molecule.residue_colours(ubiquitin, Colouring.SECONDARY_STRUCTURE)
     assert ss.shape == (76, 3) and ss.dtype == np.uint8

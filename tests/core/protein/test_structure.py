@@ -20,6 +20,7 @@ from core.protein.structure import (
     SS_FROM_PDB_RECORDS,
     Structure,
     StructureError,
+    ca_rows,
 )
 from core.protein.writing import write_structure
 
@@ -593,3 +594,11 @@ def test_an_unmoved_structure_reads_back_record_by_record(tmp_path: Path, name: 
         def lines(text: list[str]) -> list[str]:
             return [line.rstrip() for line in text if line[:6].strip().rstrip("123") == group]
         assert lines(written) == lines(original), group
+
+
+def test_ca_rows_point_at_the_backbone_ca() -> None:
+    for name in ("1UBQ.pdb.gz", "4HHB.pdb.gz"):
+        structure = read_structure(DATA / name)
+        rows = ca_rows(structure)
+        assert np.array_equal(structure.coords[rows], np.concatenate([s.ca for s in structure.segments]))
+        assert set(structure.atoms.name[rows]) == {"CA"}
