@@ -12,6 +12,7 @@ why. Nothing here changes the document.
 from __future__ import annotations
 
 from enum import StrEnum
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyvista as pv
@@ -23,7 +24,9 @@ from app.editor.document import Change, Document, Pick
 from app.editor.drag import HANDLE_BOX, HANDLE_RADIUS
 from app.editor.scene import molecule, tube
 from app.editor.scene.molecule import Colouring
-from app.editor.scene.view import View
+
+if TYPE_CHECKING:
+    from app.editor.scene.view import View
 
 TUBE_SIDES = 12
 TUBE_RADIUS = 0.55
