@@ -490,7 +490,13 @@ class Scene(QObject):
         level's spacing or the camera's distance asks for another size (by more than 5%)."""
         if "control_points" not in self.meshes or not len(self._shown_xyz):
             return
-        points = self._shown_xyz
+        radius = self._wanted_radius(self._shown_xyz)
+        if abs(radius - self.point_radius) > 0.05 * self.point_radius:
+            self.point_radius = radius
+            self._update_control_points(resized=True)
+
+    def _wanted_radius(self, points: np.ndarray) -> float:
+        """Å, the sphere radius for control points ``points`` seen from the camera now."""
         spacing = float(np.median(np.linalg.norm(np.diff(points, axis=0), axis=1))) if len(points) > 1 else 0.0
         camera = self.plotter.renderer.GetActiveCamera()
         height = max(self.plotter.renderer.GetSize()[1], 1)
@@ -499,10 +505,7 @@ class Scene(QObject):
         else:
             depth = float((points.mean(axis=0) - np.array(camera.GetPosition())) @ camera.GetDirectionOfProjection())
             pixel = 2.0 * np.tan(np.radians(camera.GetViewAngle()) / 2.0) * max(depth, 0.0) / height
-        radius = max(HANDLE_RADIUS, min(POINT_SPACING_FRACTION * spacing, MAX_POINT_RADIUS), MIN_POINT_PIXELS * pixel)
-        if abs(radius - self.point_radius) > 0.05 * self.point_radius:
-            self.point_radius = radius
-            self._update_control_points(resized=True)
+        return max(HANDLE_RADIUS, min(POINT_SPACING_FRACTION * spacing, MAX_POINT_RADIUS), MIN_POINT_PIXELS * pixel)
 
     def _update_control_points(self, resized: bool = False) -> None:
         curve = self.document.level_curve()
@@ -519,6 +522,10 @@ class Scene(QObject):
             if pick is not self._shown_pick:
                 self._write("control_points", slice(None), np.repeat(colours, len(self._sphere), axis=0), "colours")
         elif "control_points" in self.meshes:  # another level or size: new glyph data under the same actors
+            if not resized:  # another level: its spacing asks for another size (not rebuilt again before the frame)
+                radius = self._wanted_radius(points)
+                if abs(radius - self.point_radius) > 0.05 * self.point_radius:
+                    self.point_radius = radius
             self.meshes["control_points"].shallow_copy(self._glyphs(points, self.point_radius, colours))
             self.meshes["control_polygon"].shallow_copy(_polyline(points))
             self._box_corners = np.array(_box_edges(HANDLE_BOX * self.point_radius).points)
