@@ -494,9 +494,15 @@ def comparison_report(result: Comparison, label_a: str, label_b: str) -> dict:
         "tm_score_length": result.length_a,
         "tm_score_d0": round(result.d0, 4),
         "tm_score_note": "superposition on all paired Cα; normalised by the length of the first chain",
+        "tm_score_a": round(result.match.tm_score_a, 4),
+        "tm_score_b": round(result.match.tm_score_b, 4),
+        "n_aligned": result.match.n_aligned,
+        "rms_aligned": round(result.match.rms_aligned, 4),
+        "identity": round(result.match.identity, 4),
+        "same_fold": result.match.same_fold,
         "core_rule": result.core_rule,
         "n_core": result.n_core,
-        "rms_core": round(result.rms_core, 4),
+        "rms_core": round(result.rms_core, 4) if result.fits else None,
         "fits": [
             {"points": f.points, "depth": f.depth, "every": f.every, "start": f.start, "n_fit": f.n_fit,
              "rms_core": round(f.rms_core, 4)}
@@ -513,6 +519,16 @@ def comparison_text(report: dict) -> str:
         f"fit on all paired Cα: rms {report['rms_all']:.3f} Å; TM-score {report['tm_score']:.4f} (of this "
         f"superposition, normalised by the length of the first chain, {report['tm_score_length']} residues; "
         f"d0 = {report['tm_score_d0']:.2f} Å)",
+        f"structural match: TM-score {report['tm_score_a']:.4f} (normalised by the first chain, "
+        f"{report['length_a']} residues), {report['tm_score_b']:.4f} (by the second, {report['length_b']}); "
+        f"{report['n_aligned']} aligned pairs, rms {report['rms_aligned']:.3f} Å, sequence identity "
+        f"{100 * report['identity']:.1f}%",
+        "same fold (TM-score >= 0.5)" if report["same_fold"] else "different folds (TM-score < 0.5)",
+    ]
+    if not report["fits"]:
+        return "\n".join(lines + [f"core set: {report['n_core']} pairs ({report['core_rule']}): too few for the "
+                                   "fits on fewer data (at least 3 are needed)"])
+    lines += [
         f"core set: {report['n_core']} pairs ({report['core_rule']}); best fit on the core: rms {report['rms_core']:.3f} Å",
         "",
         "fits on fewer data, each judged by the rms over the core set (Å):",
