@@ -29,7 +29,7 @@ from core.analysis.superpose import MIN_PAIRS, Superposition, fit_subsets
 PAIR_CUTOFF = 5.0
 """Å: pairs farther apart after the final superposition are not structurally equivalent
 (:func:`align_structures`)."""
-ROUNDS = 5
+ROUNDS = 3
 """Superposition and pairing rounds at most from each start; a start stops as soon as a
 round does not raise its TM-score."""
 STATE_GAP = 1.0
@@ -51,9 +51,9 @@ SCREEN_SEARCH_ROUNDS = 3
 """Refinements of the TM-score search in that round (TM-align's quick score takes three)."""
 COARSE_FROM = 150
 """Residues of the shorter chain from which the search runs on every other residue first."""
-FINE_STARTS = 4
+FINE_STARTS = 2
 """Starts refined on all residues after the search on every other residue."""
-FINE_ROUNDS = 3
+FINE_ROUNDS = 2
 """Rounds of the search on all residues."""
 GAPS = (0.6, 0.0)
 """Score lost per gap in the pairings of the rounds on all residues (TM-align's two passes);
@@ -252,8 +252,7 @@ def _refine(ca_a: np.ndarray, ca_b: np.ndarray, rotation: np.ndarray, translatio
     active = np.arange(len(rotation))
     for _ in range(rounds):
         moved = ca_b @ np.swapaxes(rotation[active], 1, 2) + translation[active][:, None]
-        terms = _terms(ca_a, moved, d0)
-        found = _free_pairings(terms) if gaps is None else _pairings(terms, gaps[active])
+        found = _gapped_pairings(_terms(ca_a, moved, d0), np.zeros(len(active)) if gaps is None else gaps[active])
         keep = [k for k, pairs in enumerate(found) if len(pairs[0]) >= MIN_PAIRS]
         if not keep:
             break
@@ -429,6 +428,14 @@ def _tm_search(fixed: np.ndarray, moving: np.ndarray, valid: np.ndarray, seeds: 
 
 
 # ---------------------------------------------------------------------- the pairing by dynamic programming
+
+
+def _gapped_pairings(score: np.ndarray, gaps: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """:func:`_pairings`, by :func:`_free_pairings` for the matrices without gap penalty."""
+    free = gaps == 0.0
+    found = dict(zip(np.flatnonzero(free), _free_pairings(score[:, free]) if free.any() else []))
+    found |= dict(zip(np.flatnonzero(~free), _pairings(score[:, ~free], gaps[~free]) if (~free).any() else []))
+    return [found[k] for k in range(len(gaps))]
 
 
 def _pairings(score: np.ndarray, gaps: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
