@@ -137,10 +137,10 @@ def _table(report: dict) -> str:
     lines = [f"{report['query']} ({report['query_length']} residues) against {report['searched']} chains: "
              f"{report['aligned']} nearest by descriptor aligned in {report['seconds']:.2f} s",
              "TM-score normalised by the query (and by the hit); below 0.5 the folds differ",
-             f"{'rank':>4}  {'entry':<10}{'chain':<7}{'length':>7}{'TM-score':>10}{'(hit)':>8}{'aligned':>9}"
+             f"{'rank':>4}  {'entry':<12} {'chain':<6}{'length':>7}{'TM-score':>10}{'(hit)':>8}{'aligned':>9}"
              f"{'rms Å':>8}{'identity':>10}{'descr. Å':>10}"]
     for rank, hit in enumerate(report["hits"], 1):
-        lines.append(f"{rank:>4}  {hit['entry']:<10}{hit['chain']:<7}{hit['length']:>7}{hit['tm_score']:>10.4f}"
+        lines.append(f"{rank:>4}  {hit['entry']:<12} {hit['chain']:<6}{hit['length']:>7}{hit['tm_score']:>10.4f}"
                      f"{hit['tm_score_hit']:>8.4f}{hit['n_aligned']:>9}{hit['rms']:>8.2f}"
                      f"{100 * hit['identity']:>9.1f}%{hit['descriptor_distance']:>10.2f}")
     return "\n".join(lines)
