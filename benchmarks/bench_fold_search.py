@@ -118,9 +118,9 @@ def family_separation(folder: Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("folder", type=Path)
-    parser.add_argument("--queries", type=int, default=12, help="query chains spread over the index (default 12)")
+    parser.add_argument("--queries", type=int, default=8, help="query chains spread over the index (default 8)")
     parser.add_argument("--all", action="store_true", help="every chain of the index as a query")
-    parser.add_argument("--candidates", type=int, default=40, help="chains aligned per query (default 40)")
+    parser.add_argument("--candidates", type=int, default=20, help="chains aligned per query (default 20)")
     parser.add_argument("--labelled", type=Path, help="a folder of family subfolders")
     args = parser.parse_args()
     print(f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())} on {os.cpu_count()} cores")

@@ -89,7 +89,7 @@ def search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("index", type=Path, metavar="DB", help="an index written by 'ribbonwave index'")
     parser.add_argument("--top", type=bounded(int, 1, 10000), default=10, metavar="K",
                         help="hits to print (default %(default)s)")
-    parser.add_argument("--candidates", type=bounded(int, 1, 100000), default=40, metavar="C",
+    parser.add_argument("--candidates", type=bounded(int, 1, 100000), default=20, metavar="C",
                         help="chains nearest the query's descriptor that are aligned by structure "
                         "(default %(default)s)")
     parser.add_argument("--json", action="store_true", help="print a JSON object instead of the table")

@@ -194,7 +194,7 @@ class Hit:
     match: FoldMatch
 
 
-def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candidates: int = 40) -> list[Hit]:
+def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candidates: int = 20) -> list[Hit]:
     """The ``top`` chains of ``index`` of highest TM-score (normalised by the query) among the
     ``candidates`` nearest to the query's descriptor, best first.
 
