@@ -147,26 +147,24 @@ def pair_residues(
     -------
     (indices into chain a, indices into chain b, the pairing used)
     """
-    pairs_a, pairs_b, pairing, _ = _pairs_and_match(chain_a, chain_b, pairing)
+    pairs_a, pairs_b, pairing, _ = _pairs_and_alignment(chain_a, chain_b, pairing)
     return pairs_a, pairs_b, pairing
 
 
-def _pairs_and_match(chain_a: Sequence[BackboneSegment], chain_b: Sequence[BackboneSegment], pairing: str
-                     ) -> tuple[np.ndarray, np.ndarray, str, FoldMatch | None]:
-    """:func:`pair_residues` and the :class:`FoldMatch` of its pairing (of the whole
-    structural alignment for ``'structure'``; None for fewer than 3 pairs)."""
+def _pairs_and_alignment(chain_a: Sequence[BackboneSegment], chain_b: Sequence[BackboneSegment], pairing: str
+                         ) -> tuple[np.ndarray, np.ndarray, str, tuple[np.ndarray, np.ndarray]]:
+    """:func:`pair_residues` and the pairs to sum up as TM-align does: the whole structural
+    alignment for ``'structure'``, the same pairs otherwise."""
     pairs_a, pairs_b, pairing = pair_by_sequence(chain_a, chain_b, pairing)
-    ca_a, ca_b = (np.concatenate([s.ca for s in chain]) for chain in (chain_a, chain_b))
-    names = _names(chain_a), _names(chain_b)
     if pairing != "structure":
-        match = fold_match(ca_a, ca_b, pairs_a, pairs_b, *names) if len(pairs_a) >= MIN_PAIRS else None
-        return pairs_a, pairs_b, pairing, match
+        return pairs_a, pairs_b, pairing, (pairs_a, pairs_b)
+    ca_a, ca_b = (np.concatenate([s.ca for s in chain]) for chain in (chain_a, chain_b))
     start = (pairs_a, pairs_b) if len(pairs_a) >= MIN_PAIRS else (None, None)
     alignment = align_folds(ca_a, ca_b, *start)
     equivalent = alignment.within(ca_a, ca_b, PAIR_CUTOFF)
     if len(equivalent[0]) < MIN_PAIRS:  # unrelated folds: what the alignment found
         equivalent = alignment.pairs_a, alignment.pairs_b
-    return *equivalent, "structure", fold_match(ca_a, ca_b, alignment.pairs_a, alignment.pairs_b, *names)
+    return *equivalent, "structure", (alignment.pairs_a, alignment.pairs_b)
 
 
 def fold_match(ca_a: np.ndarray, ca_b: np.ndarray, pairs_a: np.ndarray, pairs_b: np.ndarray,
@@ -262,9 +260,11 @@ def compare_chains(
         Fewer than 3 pairs, or a core set given by the user of fewer than 3 pairs (a core
         set found by the cutoff rule may have fewer: then there are no fits on fewer data).
     """
-    pairs_a, pairs_b, pairing, match = _pairs_and_match(chain_a, chain_b, pairing)
+    pairs_a, pairs_b, pairing, aligned = _pairs_and_alignment(chain_a, chain_b, pairing)
     if len(pairs_a) < MIN_PAIRS:
         raise ValueError(f"only {len(pairs_a)} residue pair(s) between the chains; at least {MIN_PAIRS} are needed")
+    match = fold_match(*(np.concatenate([s.ca for s in chain]) for chain in (chain_a, chain_b)), *aligned,
+                       _names(chain_a), _names(chain_b))
     ca_a = np.concatenate([s.ca for s in chain_a])[pairs_a]
     ca_b = np.concatenate([s.ca for s in chain_b])[pairs_b]
     everything = superpose(ca_a, ca_b)

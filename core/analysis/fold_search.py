@@ -51,6 +51,11 @@ RESAMPLED_LEVEL = 6
 LEVEL_SIZES = tuple((2**level + 3) * (2**level + 2) // 2 for level in LEVELS)
 """Distances per level: 21, 55, 171."""
 DESCRIPTOR_SIZE = sum(LEVEL_SIZES)
+LEVEL_WEIGHTS = np.concatenate([np.full(size, 1.0 / (size * len(LEVEL_SIZES)), dtype=np.float32)
+                                for size in LEVEL_SIZES])
+"""Each distance's weight in :func:`descriptor_distances`: each level counts alike."""
+RANK_BLOCK = 8192
+"""Index rows ranked at once."""
 MIN_RESIDUES = 20
 """Chains with fewer residues are not indexed (peptides have no fold to search)."""
 FORMAT = 1
@@ -73,15 +78,16 @@ def curve_descriptor(ca: np.ndarray) -> np.ndarray:
 
 def descriptor_distances(descriptors: np.ndarray, query: np.ndarray) -> np.ndarray:
     """(n,) the difference of each row of ``descriptors`` (n, DESCRIPTOR_SIZE) from ``query``:
-    the root of the mean, over :data:`LEVELS`, of each level's mean squared distance difference, Å."""
-    difference = np.asarray(descriptors, dtype=np.float32) - np.asarray(query, dtype=np.float32)
-    squared = difference * difference
-    total = np.zeros(len(squared), dtype=np.float64)
-    first = 0
-    for size in LEVEL_SIZES:
-        total += squared[:, first:first + size].mean(axis=1)
-        first += size
-    return np.sqrt(total / len(LEVEL_SIZES))
+    the root of the mean, over :data:`LEVELS`, of each level's mean squared distance difference, Å.
+    Computed :data:`RANK_BLOCK` rows at a time, so a float16 index of the whole PDB is ranked
+    without a float32 copy of it."""
+    query = np.asarray(query, dtype=np.float32)
+    distance = np.empty(len(descriptors))
+    for first in range(0, len(descriptors), RANK_BLOCK):
+        difference = np.asarray(descriptors[first:first + RANK_BLOCK], dtype=np.float32) - query
+        np.square(difference, out=difference)
+        distance[first:first + RANK_BLOCK] = difference @ LEVEL_WEIGHTS
+    return np.sqrt(distance)
 
 
 @dataclass(frozen=True, eq=False)
