@@ -79,7 +79,8 @@ def versus_tm_align(index: FoldIndex, queries: np.ndarray, candidates: int) -> N
     extrapolated = (ours.mean() - ranking.mean() + per_chain * PDB_CHAINS) / (theirs.mean() / len(index) * PDB_CHAINS)
     print(f"\n{len(queries)} queries against {len(index)} chains: top-{TOP} overlap with TM-align "
           f"{np.mean(overlaps):.0%} (worst {min(overlaps):.0%}); of TM-align's hits of the same fold (TM-score >= 0.5) "
-          f"among its top {TOP}, {sum(found) / max(sum(folds), 1):.0%} are in the search's; a query costs {ours.mean():.2f} s against {theirs.mean():.1f} s, "
+          f"among its top {TOP}, {sum(found) / max(sum(folds), 1):.0%} are in the search's; a query costs "
+          f"{ours.mean():.2f} s against {theirs.mean():.1f} s, "
           f"{ours.sum() / theirs.sum():.4f} of the exhaustive ranking (1/{theirs.sum() / ours.sum():.0f})")
     print(f"descriptor ranking {1e9 * per_chain:.0f} ns a chain; extrapolated to {PDB_CHAINS:,} chains: "
           f"{extrapolated:.5f} of the exhaustive ranking (1/{1 / extrapolated:.0f})")
