@@ -25,9 +25,10 @@ import struct
 import sys
 import tempfile
 import urllib.parse
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 from tqdm import tqdm
@@ -76,6 +77,7 @@ PAPER = {2: 2.1, 3: 3.3}
 """Carson's pooled rms (Å) of the peptide-plane ribbon at integer depths 2 and 3."""
 CLASS_COLOURS = {"all": "black", "helix": "tab:red", "sheet": "tab:blue", "other": "tab:gray"}
 RIBBON_TITLES = {"peptide": "peptide-plane ribbon", "calpha": "Cα ribbon"}
+T = TypeVar("T")
 Outcome = tuple[FileAnalysis | SkippedFile, str]
 """A file's analysis (or why it was skipped) and its ``residues.csv`` rows."""
 
@@ -122,7 +124,8 @@ def run_analyze(args: argparse.Namespace) -> int:
     with (_staging(args.output) as staging, (staging / "residues.csv").open("w", encoding="utf-8") as table,
           tqdm(total=len(paths), unit="file", desc="analysing", file=sys.stderr, mininterval=0.5) as progress):
         table.write(",".join(RESIDUE_COLUMNS + tuple(c.name for c in options.columns)) + "\n")
-        for index, (result, lines) in _run(paths, options, args.jobs, args.scheduler):
+        task = functools.partial(analyse_file, options=options)
+        for index, (result, lines) in run_tasks(task, paths, args.jobs, args.scheduler, _failed_file):
             progress.update()
             if isinstance(result, SkippedFile):
                 progress.write(f"skipped {result.path}: {result.reason}", file=sys.stderr)
@@ -166,30 +169,33 @@ def structure_paths(paths: list[Path]) -> list[Path]:
     return found
 
 
-def _run(paths: list[Path], options: AnalysisOptions, jobs: int, scheduler: str | None
-         ) -> Iterator[tuple[int, Outcome]]:
-    """(index, result) of every path, in order of completion."""
+def run_tasks(task: Callable[[Path], T], paths: list[Path], jobs: int, scheduler: str | None,
+              failed: Callable[[Path, str], T]) -> Iterator[tuple[int, T]]:
+    """(index, ``task(path)``) of every path, in order of completion: in this process
+    (``jobs`` 1), in ``jobs`` worker processes, or on the Dask cluster at ``scheduler``
+    ('local': a private one of ``jobs`` workers). ``task`` must pickle (a top-level function,
+    or a partial of one); a worker that dies gives ``failed(path, reason)``."""
     if scheduler is not None:
-        yield from _run_dask(paths, options, jobs, scheduler)
+        yield from _run_dask(task, paths, jobs, scheduler, failed)
     elif jobs == 1 or len(paths) == 1:
         for index, path in enumerate(paths):
-            yield index, analyse_file(path, options)
+            yield index, task(path)
     else:
         context = multiprocessing.get_context("spawn")  # no fork of a threaded parent; workers are its children
         with ProcessPoolExecutor(min(jobs, len(paths)), mp_context=context, initializer=_end_with_parent,
                                  initargs=(os.getpid(),)) as pool:
-            futures = {pool.submit(analyse_file, path, options): index for index, path in enumerate(paths)}
+            futures = {pool.submit(task, path): index for index, path in enumerate(paths)}
             try:
                 for future in as_completed(futures):
                     index = futures.pop(future)  # hold no finished result longer than needed
-                    yield index, _outcome(future, paths[index])
+                    yield index, _outcome(future, paths[index], failed)
             except BaseException:  # Ctrl+C or an error: drop the files not started yet
                 pool.shutdown(cancel_futures=True)
                 raise
 
 
-def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: str
-              ) -> Iterator[tuple[int, Outcome]]:
+def _run_dask(task: Callable[[Path], T], paths: list[Path], jobs: int, address: str,
+              failed: Callable[[Path, str], T]) -> Iterator[tuple[int, T]]:
     try:
         import dask
         from dask.distributed import Client, LocalCluster, as_completed as dask_completed
@@ -204,13 +210,13 @@ def _run_dask(paths: list[Path], options: AnalysisOptions, jobs: int, address: s
                 client = stack.enter_context(Client(address, timeout=DASK_TIMEOUT))
         except (OSError, ValueError, TimeoutError) as error:
             raise InputError(f"cannot reach the Dask scheduler {address}: {error}") from None
-        futures = client.map(analyse_file, paths, options=options, pure=False)
+        futures = client.map(task, paths, pure=False)
         index = {future.key: k for k, future in enumerate(futures)}
         completed = dask_completed(futures)
         del futures  # a result is released on the cluster once it has been handled
         for future in completed:
             k = index.pop(future.key)
-            yield k, _outcome(future, paths[k])
+            yield k, _outcome(future, paths[k], failed)
 
 
 def _local_client(stack: contextlib.ExitStack, local_cluster: type, client: type, jobs: int, dask: object) -> object:
@@ -285,12 +291,16 @@ def _end_with_parent(parent: int) -> None:
             os._exit(1)
 
 
-def _outcome(future, path: Path) -> Outcome:
-    """A finished task's outcome; a worker that died gives a skipped file, not a failed run."""
+def _outcome(future, path: Path, failed: Callable[[Path, str], T]) -> T:
+    """A finished task's outcome; a worker that died gives ``failed``'s, not a failed run."""
     try:
         return future.result()
     except Exception as error:  # noqa: BLE001 - e.g. a worker killed while reading this file
-        return SkippedFile(path, f"worker failed ({type(error).__name__}: {error})"), ""
+        return failed(path, f"worker failed ({type(error).__name__}: {error})")
+
+
+def _failed_file(path: Path, reason: str) -> Outcome:
+    return SkippedFile(path, reason), ""
 
 
 def _prepare_output(folder: Path, overwrite: bool) -> None:
@@ -494,9 +504,15 @@ def comparison_report(result: Comparison, label_a: str, label_b: str) -> dict:
         "tm_score_length": result.length_a,
         "tm_score_d0": round(result.d0, 4),
         "tm_score_note": "superposition on all paired Cα; normalised by the length of the first chain",
+        "tm_score_a": round(result.match.tm_score_a, 4),
+        "tm_score_b": round(result.match.tm_score_b, 4),
+        "n_aligned": result.match.n_aligned,
+        "rms_aligned": round(result.match.rms_aligned, 4),
+        "identity": round(result.match.identity, 4),
+        "same_fold": result.match.same_fold,
         "core_rule": result.core_rule,
         "n_core": result.n_core,
-        "rms_core": round(result.rms_core, 4),
+        "rms_core": round(result.rms_core, 4) if result.fits else None,
         "fits": [
             {"points": f.points, "depth": f.depth, "every": f.every, "start": f.start, "n_fit": f.n_fit,
              "rms_core": round(f.rms_core, 4)}
@@ -513,6 +529,16 @@ def comparison_text(report: dict) -> str:
         f"fit on all paired Cα: rms {report['rms_all']:.3f} Å; TM-score {report['tm_score']:.4f} (of this "
         f"superposition, normalised by the length of the first chain, {report['tm_score_length']} residues; "
         f"d0 = {report['tm_score_d0']:.2f} Å)",
+        f"structural match: TM-score {report['tm_score_a']:.4f} (normalised by the first chain, "
+        f"{report['length_a']} residues), {report['tm_score_b']:.4f} (by the second, {report['length_b']}); "
+        f"{report['n_aligned']} aligned pairs, rms {report['rms_aligned']:.3f} Å, sequence identity "
+        f"{100 * report['identity']:.1f}%",
+        "same fold (TM-score >= 0.5)" if report["same_fold"] else "different folds (TM-score < 0.5)",
+    ]
+    if not report["fits"]:
+        return "\n".join(lines + [f"core set: {report['n_core']} pairs ({report['core_rule']}): too few for the "
+                                   "fits on fewer data (at least 3 are needed)"])
+    lines += [
         f"core set: {report['n_core']} pairs ({report['core_rule']}); best fit on the core: rms {report['rms_core']:.3f} Å",
         "",
         "fits on fewer data, each judged by the rms over the core set (Å):",

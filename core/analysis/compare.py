@@ -12,7 +12,9 @@ less data are evaluated on the core set:
 
 each fit's motion is applied to the second chain's Cα and the rms over the core pairs
 reported. The TM-score of the superposition on all pairs is normalised by the length of
-the first chain.
+the first chain. Whatever the pairing, :class:`FoldMatch` sums it up as TM-align does (the
+TM-score superposition, normalised by either chain, the aligned pairs, their rms and sequence
+identity); chains of different folds have no core set, and then no fits on fewer data either.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ import numpy as np
 
 from core.analysis.database import Termini
 from core.analysis.deviation import level_residue_points
-from core.analysis.fold_alignment import align_structures, tm_d0
+from core.analysis.fold_alignment import PAIR_CUTOFF, align_folds, tm_d0, tm_d8, tm_superpose
 from core.analysis.superpose import MIN_PAIRS, Superposition, align_sequences, fit_closest, superpose
 from core.protein.ribbon import RibbonKind, build_ribbon
 from core.protein.structure import BackboneSegment
@@ -35,6 +37,34 @@ PAIRINGS = ("auto", "numbering", "alignment", "structure")
 SAME_PROTEIN = 0.9
 """Sequence identity (of the shorter chain) from which two chains are the same protein,
 paired by sequence whatever their conformations."""
+SAME_FOLD = 0.5
+"""TM-score from which two chains have the same fold (Xu & Zhang 2010)."""
+
+
+@dataclass(frozen=True)
+class FoldMatch:
+    """A pairing summed up as TM-align does (:func:`fold_match`).
+
+    Attributes
+    ----------
+    tm_score_a, tm_score_b : TM-score of the aligned pairs, normalised by chain a's and by
+        chain b's length (each with its d0 and its own TM-score superposition).
+    n_aligned : pairs closer than :func:`~core.analysis.fold_alignment.tm_d8` of the shorter
+        chain after the TM-score superposition (normalised by chain a).
+    rms_aligned : their rms distance after that superposition, Å.
+    identity : the fraction of them with the same residue name.
+    """
+
+    tm_score_a: float
+    tm_score_b: float
+    n_aligned: int
+    rms_aligned: float
+    identity: float
+
+    @property
+    def same_fold(self) -> bool:
+        """Whether either TM-score reaches :data:`SAME_FOLD`."""
+        return max(self.tm_score_a, self.tm_score_b) >= SAME_FOLD
 
 
 @dataclass(frozen=True)
@@ -71,8 +101,10 @@ class Comparison:
     tm_score, d0 : TM-score of that fit, normalised by ``length_a``, and its d0 (Å).
     core : (n_pairs,) bool, the core set.
     core_rule : how the core set was chosen.
-    rms_core : rms over the core pairs of the fit on the core pairs, Å.
-    fits : every fit on fewer data, in the order Cα by step, then C^r by depth.
+    rms_core : rms over the core pairs of the fit on the core pairs, Å (NaN without a core set).
+    fits : every fit on fewer data, in the order Cα by step, then C^r by depth; none when the
+        core set has fewer than 3 pairs.
+    match : the pairing summed up as TM-align does.
     """
 
     pairing: str
@@ -87,6 +119,7 @@ class Comparison:
     core_rule: str
     rms_core: float
     fits: tuple[Fit, ...]
+    match: FoldMatch
 
     @property
     def n_pairs(self) -> int:
@@ -104,20 +137,52 @@ def pair_residues(
 
     ``'numbering'`` pairs equal residue numbers and insertion codes; ``'alignment'`` aligns
     the residue-name sequences (:func:`core.analysis.superpose.align_sequences`); ``'structure'``
-    pairs the residues by where the Cα lie (:func:`core.analysis.fold_alignment.align_structures`,
-    started also from the sequence alignment), which homologues need. ``'auto'`` decides as
+    pairs the residues by where the Cα lie (:func:`core.analysis.fold_alignment.align_folds`,
+    started also from the sequence alignment; its pairs within
+    :data:`~core.analysis.fold_alignment.PAIR_CUTOFF`, or all of them for unrelated folds),
+    which homologues need. ``'auto'`` decides as
     :func:`pair_by_sequence` does.
 
     Returns
     -------
     (indices into chain a, indices into chain b, the pairing used)
     """
+    pairs_a, pairs_b, pairing, _ = _pairs_and_alignment(chain_a, chain_b, pairing)
+    return pairs_a, pairs_b, pairing
+
+
+def _pairs_and_alignment(chain_a: Sequence[BackboneSegment], chain_b: Sequence[BackboneSegment], pairing: str
+                         ) -> tuple[np.ndarray, np.ndarray, str, tuple[np.ndarray, np.ndarray]]:
+    """:func:`pair_residues` and the pairs to sum up as TM-align does: the whole structural
+    alignment for ``'structure'``, the same pairs otherwise."""
     pairs_a, pairs_b, pairing = pair_by_sequence(chain_a, chain_b, pairing)
     if pairing != "structure":
-        return pairs_a, pairs_b, pairing
+        return pairs_a, pairs_b, pairing, (pairs_a, pairs_b)
     ca_a, ca_b = (np.concatenate([s.ca for s in chain]) for chain in (chain_a, chain_b))
     start = (pairs_a, pairs_b) if len(pairs_a) >= MIN_PAIRS else (None, None)
-    return *align_structures(ca_a, ca_b, *start), "structure"
+    alignment = align_folds(ca_a, ca_b, *start)
+    equivalent = alignment.within(ca_a, ca_b, PAIR_CUTOFF)
+    if len(equivalent[0]) < MIN_PAIRS:  # unrelated folds: what the alignment found
+        equivalent = alignment.pairs_a, alignment.pairs_b
+    return *equivalent, "structure", (alignment.pairs_a, alignment.pairs_b)
+
+
+def fold_match(ca_a: np.ndarray, ca_b: np.ndarray, pairs_a: np.ndarray, pairs_b: np.ndarray,
+               names_a: np.ndarray, names_b: np.ndarray) -> FoldMatch:
+    """TM-align's summary of paired Cα (3 pairs or more): the pairs within ``tm_d8`` of the
+    shorter chain after the TM-score superposition, their TM-score normalised by either
+    chain, rms and sequence identity (``names_*``: residue names of each chain)."""
+    length_a, length_b = len(ca_a), len(ca_b)
+    motion, _ = tm_superpose(ca_a[pairs_a], ca_b[pairs_b], length_a)
+    distance = np.linalg.norm(ca_a[pairs_a] - motion.apply(ca_b[pairs_b]), axis=1)
+    close = distance < tm_d8(min(length_a, length_b))
+    if close.sum() < MIN_PAIRS:
+        close = np.argsort(distance)[:MIN_PAIRS]
+    a, b = pairs_a[close], pairs_b[close]
+    motion_a, score_a = tm_superpose(ca_a[a], ca_b[b], length_a)
+    _, score_b = tm_superpose(ca_a[a], ca_b[b], length_b)
+    rms = float(np.sqrt(np.mean(np.sum((ca_a[a] - motion_a.apply(ca_b[b])) ** 2, axis=1))))
+    return FoldMatch(score_a, score_b, len(a), rms, float(np.mean(names_a[a] == names_b[b])))
 
 
 def pair_by_sequence(
@@ -192,11 +257,14 @@ def compare_chains(
     Raises
     ------
     ValueError
-        Fewer than 3 pairs, or a core set of fewer than 3 pairs.
+        Fewer than 3 pairs, or a core set given by the user of fewer than 3 pairs (a core
+        set found by the cutoff rule may have fewer: then there are no fits on fewer data).
     """
-    pairs_a, pairs_b, pairing = pair_residues(chain_a, chain_b, pairing)
+    pairs_a, pairs_b, pairing, aligned = _pairs_and_alignment(chain_a, chain_b, pairing)
     if len(pairs_a) < MIN_PAIRS:
         raise ValueError(f"only {len(pairs_a)} residue pair(s) between the chains; at least {MIN_PAIRS} are needed")
+    match = fold_match(*(np.concatenate([s.ca for s in chain]) for chain in (chain_a, chain_b)), *aligned,
+                       _names(chain_a), _names(chain_b))
     ca_a = np.concatenate([s.ca for s in chain_a])[pairs_a]
     ca_b = np.concatenate([s.ca for s in chain_b])[pairs_b]
     everything = superpose(ca_a, ca_b)
@@ -207,8 +275,12 @@ def compare_chains(
         core, rule = _iterative_core(ca_a, ca_b, cutoff), f"pairs within {cutoff:g} Å after an iterative fit"
     else:
         core, rule = np.asarray(core_residues, dtype=bool)[pairs_a], "residues given by the user"
-    if core.sum() < MIN_PAIRS:
+    if core.sum() < MIN_PAIRS and core_residues is not None:
         raise ValueError(f"the core set has {int(core.sum())} pair(s); at least {MIN_PAIRS} are needed")
+    fits: list[Fit] = []
+    if core.sum() < MIN_PAIRS:  # different folds: nothing to judge fits on
+        return Comparison(pairing, pairs_a, pairs_b, length_a, sum(len(s) for s in chain_b), _rms(distances), tm,
+                          d0, core, rule, float("nan"), (), match)
     best = superpose(ca_a[core], ca_b[core])
 
     def judged(points: str, depth: int, every: int, fit_a: np.ndarray, fit_b: np.ndarray) -> list[Fit]:
@@ -222,7 +294,7 @@ def compare_chains(
                 found.append(Fit(points, depth, every, start + 1, int(usable.sum()), rms))
         return found
 
-    fits = judged("CA", 0, 1, ca_a, ca_b)
+    fits += judged("CA", 0, 1, ca_a, ca_b)
     for every in steps:
         fits += judged("CA", 0, every, ca_a, ca_b)
     kind, termini = RibbonKind(ribbon), Termini(termini)
@@ -244,6 +316,7 @@ def compare_chains(
         core_rule=rule,
         rms_core=_rms(_distances(ca_a[core], ca_b[core], best)),
         fits=tuple(fits),
+        match=match,
     )
 
 

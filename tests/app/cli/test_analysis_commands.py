@@ -217,6 +217,46 @@ def test_compare_two_entries_by_alignment_with_a_user_core(capsys):
     assert report["n_core"] == 91 + 1 + 41 and report["core_rule"] == "residues given by the user"
 
 
+@pytest.mark.parametrize(("first", "second"), [("1UBQ", "3PTB"), ("1FKJ", "1UBQ"), ("1AYE", "1TIM"),
+                                              ("1L2Y", "1UBQ"), ("2BEG", "1BPI"), ("1BPI", "4HHB")])
+def test_compare_never_fails_on_unrelated_chains(first, second, capsys):
+    files = [next(DATA.glob(f"{name}.*")) for name in (first, second)]
+    status, out, err = run(capsys, "compare", *files, "--steps", "4", "--depths", "2", "--json")
+    assert status == 0 and "Traceback" not in err
+    report = json.loads(out)
+    assert not report["same_fold"] and max(report["tm_score_a"], report["tm_score_b"]) < 0.5
+    assert 3 <= report["n_aligned"] <= min(report["length_a"], report["length_b"])
+    assert report["rms_aligned"] > 0 and 0 <= report["identity"] < 0.5
+
+
+def test_compare_reports_the_match_by_either_chain(capsys):
+    status, out, _ = run(capsys, "compare", DATA / "1UBQ.pdb.gz", DATA / "3PTB.pdb.gz", "--steps", "4", "--depths", "2")
+    assert status == 0
+    match = re.search(r"structural match: TM-score (\S+) \(normalised by the first chain, 76 residues\), (\S+) \(by the "
+                      r"second, 223\); (\d+) aligned pairs, rms (\S+) Å, sequence identity (\S+)%", out)
+    assert match, out
+    tm_a, tm_b = float(match[1]), float(match[2])
+    assert tm_a == pytest.approx(0.367, abs=0.03) and tm_b < tm_a  # TM-align: 0.367 by ubiquitin
+    assert "different folds (TM-score < 0.5)" in out
+
+
+def test_compare_without_a_core_set_gives_the_match_and_no_fits(capsys):
+    argv = ["compare", DATA / "1UBQ.pdb.gz", DATA / "3PTB.pdb.gz", "--core-cutoff", "0.01"]
+    status, out, _ = run(capsys, *argv)
+    assert status == 0 and "too few for the fits on fewer data" in out and "fits on fewer data, each" not in out
+    status, out, _ = run(capsys, *argv, "--json")
+    report = json.loads(out)
+    assert status == 0 and report["fits"] == [] and report["rms_core"] is None and report["n_core"] < 3
+
+
+def test_compare_of_one_fold_says_so(capsys):
+    status, out, _ = run(capsys, "compare", DATA / "3PTB.pdb.gz", DATA / "3SGB.pdb.gz", "--chains", "A:E", "--json",
+                         "--steps", "4", "--depths", "2")
+    report = json.loads(out)
+    assert status == 0 and report["same_fold"] and report["tm_score_a"] == pytest.approx(0.602, abs=0.02)
+    assert report["n_aligned"] > 150 and report["identity"] < 0.3  # TM-align: 0.602, 168 pairs
+
+
 @pytest.mark.parametrize(
     ("argv", "status", "message"),
     [

@@ -1,0 +1,165 @@
+"""Fold search commands: ``index`` (descriptors of the low-level curves of every protein chain
+of many files, in one file) and ``search`` (the chains of an index nearest a query's fold).
+Core does the science (:mod:`core.analysis.fold_search`); this module reads arguments, runs
+files in parallel as ``analyze`` does, writes the index and prints.
+
+The field names of ``search --json`` are a contract for other programs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from app.arguments import bounded
+from app.cli.analysis import run_tasks, structure_paths
+from app.cli.structure import load
+from app.errors import InputError
+from core.analysis.database import SkippedFile
+from core.analysis.fold_search import DESCRIPTOR_SIZE, MIN_RESIDUES, FoldIndex, index_path, merge, search
+from core.protein.structure import Structure
+from core.protein.writing import atomic_write
+
+# --------------------------------------------------------------------------- index
+
+
+def index_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("paths", nargs="+", type=Path, metavar="PATH",
+                        help="structure files or folders (searched recursively for .pdb/.ent/.cif/.mmcif, "
+                        "optionally .gz)")
+    parser.add_argument("-o", "--output", required=True, type=Path, metavar="DB", help="the index file to write (.npz)")
+    parser.add_argument("--overwrite", action="store_true", help="replace DB if it exists")
+    parser.add_argument("--jobs", type=bounded(int, 1, 4096), default=len(os.sched_getaffinity(0)), metavar="N",
+                        help="worker processes (default: all cores)")
+    parser.add_argument("--scheduler", nargs="?", const="local", metavar="ADDRESS",
+                        help="run on a Dask cluster (e.g. tcp://host:8786); without ADDRESS, a local cluster "
+                        "of --jobs workers (needs the 'cluster' extra: dask[distributed])")
+
+
+def run_index(args: argparse.Namespace) -> int:
+    output: Path = args.output
+    if (output.exists() or output.is_symlink()) and not args.overwrite:
+        raise InputError(f"{output}: refusing to overwrite an existing file (use --overwrite)")
+    if output.is_dir():
+        raise InputError(f"{output}: is a folder")
+    if not output.parent.is_dir():
+        raise InputError(f"{output}: no such folder {output.parent}")
+    if not os.access(output.parent, os.W_OK | os.X_OK):
+        raise InputError(f"{output.parent}: cannot write in the folder (permission denied)")
+    paths = structure_paths(args.paths)
+    start = time.perf_counter()
+    found: dict[int, FoldIndex] = {}
+    skipped: dict[int, SkippedFile] = {}
+    with tqdm(total=len(paths), unit="file", desc="indexing", file=sys.stderr, mininterval=0.5) as progress:
+        for k, result in run_tasks(index_path, paths, args.jobs, args.scheduler, SkippedFile):
+            progress.update()
+            if isinstance(result, SkippedFile):
+                progress.write(f"skipped {result.path}: {result.reason}", file=sys.stderr)
+                skipped[k] = result
+            elif len(result):
+                found[k] = result
+    if not found:
+        raise InputError(f"no protein chain of {MIN_RESIDUES} residues or more in the {len(paths)} file(s)"
+                         + (f" ({len(skipped)} skipped)" if skipped else ""))
+    index = merge([found[k] for k in sorted(found)])  # in input order, whatever order the workers finished in
+    data = index.to_bytes()
+    try:
+        atomic_write(output, data)
+    except OSError as error:
+        raise InputError(f"{output}: cannot write ({error.strerror or error})") from None
+    print(f"indexed {len(index)} chains of {len(found)} file(s) in {time.perf_counter() - start:.1f} s"
+          + (f"; skipped {len(skipped)} file(s)" if skipped else ""))
+    print(f"wrote {output} ({len(data) / 1e6:.2f} MB; descriptors {2 * DESCRIPTOR_SIZE} bytes per chain)")
+    return 0
+
+
+# --------------------------------------------------------------------------- search
+
+
+def search_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("query", metavar="QUERY[:CHAIN]",
+                        help="structure file of the query, optionally with a chain (default: its longest chain)")
+    parser.add_argument("index", type=Path, metavar="DB", help="an index written by 'ribbonwave index'")
+    parser.add_argument("--top", type=bounded(int, 1, 10000), default=10, metavar="K",
+                        help="hits to print (default %(default)s)")
+    parser.add_argument("--candidates", type=bounded(int, 1, 100000), default=20, metavar="C",
+                        help="chains nearest the query's descriptor that are aligned by structure "
+                        "(default %(default)s)")
+    parser.add_argument("--json", action="store_true", help="print a JSON object instead of the table")
+
+
+def run_search(args: argparse.Namespace) -> int:
+    path, chain = _query(args.query)
+    structure = load(path)
+    chain = chain or _longest_chain(structure)
+    segments = [s for s in structure.segments if s.chain == chain]
+    if not segments:
+        chains = ", ".join(dict.fromkeys(s.chain for s in structure.segments))
+        raise InputError(f"{path}: no protein chain {chain!r} (chains: {chains})")
+    if sum(len(s) for s in segments) < 3:
+        raise InputError(f"{path}: chain {chain} has fewer than 3 residues")
+    if not args.index.is_file():
+        raise InputError(f"{args.index}: no such file")
+    try:
+        index = FoldIndex.read(args.index)
+    except ValueError as error:
+        raise InputError(str(error)) from None
+    start = time.perf_counter()
+    ca = np.concatenate([s.ca for s in segments])
+    hits = search(index, ca, "".join(s.sequence for s in segments), args.top, args.candidates)
+    seconds = time.perf_counter() - start
+    report = {
+        "query": f"{path} chain {chain}",
+        "query_length": len(ca),
+        "searched": len(index),
+        "aligned": min(max(args.candidates, args.top), len(index)),
+        "seconds": round(seconds, 3),
+        "hits": [
+            {"entry": h.entry, "chain": h.chain, "path": h.path, "length": h.length,
+             "tm_score": round(h.match.tm_score_a, 4), "tm_score_hit": round(h.match.tm_score_b, 4),
+             "n_aligned": h.match.n_aligned, "rms": round(h.match.rms_aligned, 3),
+             "identity": round(h.match.identity, 4), "descriptor_distance": round(h.descriptor_distance, 3)}
+            for h in hits
+        ],
+    }
+    print(json.dumps(report, indent=2) if args.json else _table(report))
+    return 0
+
+
+def _table(report: dict) -> str:
+    lines = [f"{report['query']} ({report['query_length']} residues) against {report['searched']} chains: "
+             f"{report['aligned']} nearest by descriptor aligned in {report['seconds']:.2f} s",
+             "TM-score normalised by the query (and by the hit); below 0.5 the folds differ",
+             f"{'rank':>4}  {'entry':<12} {'chain':<6}{'length':>7}{'TM-score':>10}{'(hit)':>8}{'aligned':>9}"
+             f"{'rms Å':>8}{'identity':>10}{'descr. Å':>10}"]
+    for rank, hit in enumerate(report["hits"], 1):
+        lines.append(f"{rank:>4}  {hit['entry']:<12} {hit['chain']:<6}{hit['length']:>7}{hit['tm_score']:>10.4f}"
+                     f"{hit['tm_score_hit']:>8.4f}{hit['n_aligned']:>9}{hit['rms']:>8.2f}"
+                     f"{100 * hit['identity']:>9.1f}%{hit['descriptor_distance']:>10.2f}")
+    return "\n".join(lines)
+
+
+def _query(text: str) -> tuple[Path, str | None]:
+    """``FILE`` or ``FILE:CHAIN`` (a file whose name has a colon is taken whole when it exists)."""
+    if Path(text).exists() or ":" not in text:
+        return Path(text), None
+    path, chain = text.rsplit(":", 1)
+    if not chain:
+        raise InputError(f"{text}: expected FILE or FILE:CHAIN")
+    return Path(path), chain
+
+
+def _longest_chain(structure: Structure) -> str:
+    length: dict[str, int] = {}
+    for segment in structure.segments:
+        length[segment.chain] = length.get(segment.chain, 0) + len(segment)
+    if not length:
+        raise InputError(f"{structure.path}: no protein chain")
+    return max(length, key=lambda chain: length[chain])
