@@ -125,7 +125,7 @@ class MapMesh(QObject):
         if self.density is None or self._timer.isActive() or np.array_equal(self._focal_point(), self.centre):
             return
         wait = RECONTOUR_MS - 1000.0 * (time.perf_counter() - self._last)
-        self._timer.start(int(np.ceil(max(0.0, wait))))
+        self._timer.start(int(np.ceil(max(0.0, wait))) + 2)  # Qt's timers may fire a millisecond or two early
 
     def _reload(self) -> None:
         """A new structure: the scene removed every actor."""
