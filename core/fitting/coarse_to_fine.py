@@ -113,10 +113,10 @@ def fit_levels(
             return
         start = time.perf_counter()
         edits: dict[int, Edit] = {}
-        rmsd = superpose(model.coords[rows], target).rmsd
+        fit = superpose(model.coords[rows], target)
         n_points = 0
-        for step in range(STEPS_PER_LEVEL):
-            placed = superpose(model.coords[rows], target).apply(target)
+        for _ in range(STEPS_PER_LEVEL):
+            placed = fit.apply(target)
             offset = 0
             for p in pairs:
                 k = len(p.residues)
@@ -124,14 +124,14 @@ def fit_levels(
                 offset += k
                 model.apply(edit)
                 edits[p.segment] = edits[p.segment].then(edit) if p.segment in edits else edit
-            new = superpose(model.coords[rows], target).rmsd
-            settled = new > (1.0 - SETTLED) * rmsd
-            rmsd = new
+            new = superpose(model.coords[rows], target)
+            settled = new.rmsd > (1.0 - SETTLED) * fit.rmsd
+            fit = new
             if settled or cancelled():
                 break
         for p in pairs:
             n_points += spline_space(min(level, model.ribbons[p.segment].level)).n_points
-        yield LevelFit(level, n_points, rmsd, time.perf_counter() - start, tuple(edits.values()))
+        yield LevelFit(level, n_points, fit.rmsd, time.perf_counter() - start, tuple(edits.values()))
 
 
 def _step(model: EditableModel, pairs: Pairs, level: int, target: np.ndarray, ca: np.ndarray) -> Edit:
