@@ -25,6 +25,7 @@ from core.analysis.superpose import superpose
 from core.fitting.density import gaussian_sigma
 from core.protein.reading import read_structure
 from core.protein.structure import ca_rows
+from core.surfaces.volume import DensityMap
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 CLOSED, OPEN = "1AKE_adk_closed.pdb.gz", "4AKE_adk_open.pdb.gz"
@@ -95,17 +96,25 @@ def test_the_map_is_a_mesh_around_the_centre_that_follows_it(window: MainWindow,
     assert np.linalg.norm(maps.mesh.points - maps.centre, axis=1).max() <= 8.0
 
 
-def test_the_centre_is_contoured_at_most_ten_times_a_second(window: MainWindow, qtbot: QtBot) -> None:
+def test_the_centre_is_contoured_at_most_ten_times_a_second(
+    window: MainWindow, qtbot: QtBot, monkeypatch: pytest.MonkeyPatch
+) -> None:
     maps, times = window.maps, []
     maps.contour()
-    maps.contoured.connect(lambda: times.append(time.perf_counter()))
+    contour_around = DensityMap.contour_around
+
+    def timed(*args: object) -> object:  # the throttle spaces the starts; how long each takes varies
+        times.append(time.perf_counter())
+        return contour_around(*args)
+
+    monkeypatch.setattr(DensityMap, "contour_around", timed)
     ca = window.document.model.coords[window.document.ca_rows]
     for k in range(40):  # a fast pan: the centre moves at each of 40 frames within a few milliseconds
         window.scene.centre_on(ca[5 * k])
         window.plotter.ren_win.InvokeEvent("StartEvent")
         QApplication.processEvents()
     qtbot.waitUntil(lambda: np.array_equal(maps.centre, ca[195]))
-    assert len(times) < 40 and np.all(np.diff(times) >= RECONTOUR_MS / 1e3 - 1e-3)
+    assert 0 < len(times) < 40 and np.all(np.diff(times) >= RECONTOUR_MS / 1e3)
 
 
 def test_a_broken_map_file_gives_a_dialog(
