@@ -19,6 +19,7 @@ values and mean curvature at any point, rays cast onto the surface, the triangle
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -232,12 +233,14 @@ def molecular_surface(
     spacing: float | None = None,
     exclude: NDArray[np.bool_] | None = None,
     cavities: bool = False,
+    progress: Callable[[str], object] | None = None,
 ) -> MolecularSurface:
     """The SES of the :func:`surface_atoms` of ``atoms`` (see :func:`ses_field`)."""
     mask = surface_atoms(atoms, exclude=exclude)
     if not mask.any():
         raise ValueError(f"{atoms.entry_id}: no atoms to build a surface from (only water or hydrogens)")
-    field = ses_field(atoms.coords[mask], vdw_radii(atoms.element[mask]), probe=probe, spacing=spacing, cavities=cavities)
+    field = ses_field(atoms.coords[mask], vdw_radii(atoms.element[mask]), probe=probe, spacing=spacing,
+                      cavities=cavities, progress=progress)
     return MolecularSurface(atoms, mask, field)
 
 
@@ -248,6 +251,7 @@ def ses_field(
     probe: float = PROBE_RADIUS,
     spacing: float | None = None,
     cavities: bool = False,
+    progress: Callable[[str], object] | None = None,
 ) -> SurfaceField:
     """Solvent-excluded region of spheres, as a :class:`SurfaceField`.
 
@@ -262,6 +266,9 @@ def ses_field(
     cavities : bool
         Keep buried cavities that the probe fits into (as inner surfaces); by default they
         are filled and only the outer surface remains.
+    progress : callable, optional
+        Told the name of each stage as it starts: "distances to the atoms", "the solvent" (not
+        with ``cavities``), "distance transform", "refinement".
     """
     coords = _validate.finite_array("coords", coords, ndim=(2,))
     radii = _validate.finite_array("radii", radii, ndim=(1,))
@@ -278,13 +285,18 @@ def ses_field(
     margin = radii.max() + probe + cap + 3 * spacing
     origin = coords.min(axis=0) - margin
     shape = tuple(int(n) for n in np.ceil((size + 2 * margin) / spacing).astype(int) + 1)
+    report = progress or (lambda _stage: None)
+    report("distances to the atoms")
     sas = _sas_distance(coords, radii + probe, origin, spacing, shape, cap)
     buried = sas < 0
     if not cavities:
+        report("the solvent")
         labels, _ = ndimage.label(~buried)
         buried |= labels != labels[0, 0, 0]  # the corner is always in the solvent
+    report("distance transform")
     distance, nearest = ndimage.distance_transform_edt(buried, sampling=spacing, return_indices=True)
     to_accessible = distance - sas[tuple(nearest)]
+    report("refinement")
     band = np.flatnonzero(buried & (np.abs(to_accessible - probe) < 2 * spacing))
     nearest = np.ravel_multi_index(tuple(n.reshape(-1)[band] for n in nearest), shape)
     to_accessible.reshape(-1)[band] = _descend(band, nearest, sas, buried, spacing)

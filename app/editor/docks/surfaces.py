@@ -1,33 +1,34 @@
 """The surface panel: a globe, DNA cylinder, molecular surface, remeshed surface or density
 contour of the document's atoms, shown with the ribbon at any of its levels.
 
-A :class:`SurfaceLayer` builds surfaces with :func:`core.surfaces.levelled.build_surface` off the
-GUI thread (a one-worker executor; the result comes back through a queued Qt signal) and
-caches them per kind for the open structure, so moving the level slider or changing the
-colouring only asks the cached :class:`~core.surfaces.levelled.LevelledSurface` for another view. A
-view with the same triangles as the one on screen is written into the existing VTK arrays;
-any other goes under the same actor. Surfaces are computed from the atoms: after an edit
-the surface is stale until it is recomputed (or the edit undone). The
+A :class:`SurfaceLayer` builds surfaces in a process of their own
+(:class:`~app.editor.surface_build.SurfaceBuild`: as fast as on the command line, and never
+holding up the view), one at a time: the build of the kind chosen for the open structure.
+Choosing another kind, opening another file or closing the window kills the running build at
+once. The build's stages ("molecular surface (distance transform)") show in the panel as they
+start. Surfaces are cached per kind for the open structure, so moving the level slider or
+changing the colouring only asks the cached :class:`~core.surfaces.levelled.LevelledSurface`
+for another view. A view with the same triangles as the one on screen is written into the
+existing VTK arrays; any other goes under the same actor. Surfaces are computed from the
+atoms: after an edit the surface is stale until it is recomputed (or the edit undone). The
 :class:`SurfacePanel` dock only reads the layer and calls its mutators. The surface code
-(scikit-image, PyWavelets, ...) is imported with the first surface built, not with the editor.
+(scikit-image, PyWavelets, ...) loads in the build's process, not with the editor.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from concurrent.futures import Future, ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pyvista as pv
-from PySide6.QtCore import QObject, QSignalBlocker, Qt, Signal
+from PySide6.QtCore import QObject, QSignalBlocker, QSocketNotifier, Qt, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
     QFormLayout,
     QHBoxLayout,
     QLabel,
-    QProgressBar,
     QPushButton,
     QSlider,
     QVBoxLayout,
@@ -36,8 +37,8 @@ from PySide6.QtWidgets import (
 from vtkmodules.util.numpy_support import vtk_to_numpy
 
 from app.editor.document import Document
+from app.editor.surface_build import SurfaceBuild, start_server
 from app.polydata import scalar_style, to_polydata
-from core.protein.structure import Structure
 from core.surfaces.mesh import TriangleMesh
 
 if TYPE_CHECKING:
@@ -62,12 +63,21 @@ class Built:
     coords: np.ndarray
 
 
+@dataclasses.dataclass(eq=False)
+class _Running:
+    """The build under way, the notifier of its pipe, the coordinates it builds from and its stage."""
+
+    build: SurfaceBuild
+    notifier: QSocketNotifier
+    coords: np.ndarray
+    stage: str = "starting"
+
+
 class SurfaceLayer(QObject):
     """Builds, caches and draws the surfaces of a document's atoms into ``plotter``."""
 
     updated = Signal()
-    """Anything shown about the surface changed: built, drawn, busy, stale or failed."""
-    _finished = Signal(object, str, object, object)
+    """Anything shown about the surface changed: built, drawn, busy (or its stage), stale or failed."""
 
     def __init__(self, document: Document, plotter: pv.BasePlotter) -> None:
         super().__init__(document)
@@ -87,11 +97,10 @@ class SurfaceLayer(QObject):
         self._faces = np.empty((0, 3), dtype=np.int64)
         self._cache: dict[str, Built] = {}
         self._failed: dict[str, str] = {}
-        self._pending: set[str] = set()
+        self._running: _Running | None = None
         self._structure = document.structure if document.model is not None else None
         self._stale = False
-        self._executor = ThreadPoolExecutor(max_workers=1, thread_name_prefix="surface")
-        self._finished.connect(self._on_finished)
+        start_server()
         document.loaded.connect(self._on_loaded)
         document.changed.connect(self._on_changed)
 
@@ -105,7 +114,12 @@ class SurfaceLayer(QObject):
     @property
     def busy(self) -> bool:
         """Whether the current kind is being built."""
-        return self.kind in self._pending
+        return self._running is not None and self._running.build.kind == self.kind
+
+    @property
+    def stage(self) -> str:
+        """The stage of the build of the current kind ('' when none runs)."""
+        return self._running.stage if self.busy else ""
 
     @property
     def stale(self) -> bool:
@@ -154,8 +168,8 @@ class SurfaceLayer(QObject):
         self._update()
 
     def shutdown(self) -> None:
-        """Drop the builds not started and wait for the running one (call before the plotter closes)."""
-        self._executor.shutdown(wait=True, cancel_futures=True)
+        """Stop the running build at once (call before the plotter closes)."""
+        self._stop()
 
     # ------------------------------------------------------------------ internals
 
@@ -163,43 +177,50 @@ class SurfaceLayer(QObject):
         """Draw what the state asks for, starting a build when the surface is missing."""
         self.message = self._failed.get(self.kind, "")
         built = self.built
+        if self._running is not None and not self.busy:
+            self._stop()  # of a kind no longer chosen
         if self.visible and built is None and not self.busy and not self.message and self.document.model is not None:
-            self._build()
+            self._start()
         if self.visible and built is not None:
             self._draw(built.surface)
-        elif self.actor is not None:
+            self.plotter.render()
+        elif self.actor is not None and self.actor.GetVisibility():
             self.actor.SetVisibility(False)
+            self.plotter.render()  # only when the view changed: a frame takes 0.1-0.3 s with software OpenGL
         self._stale = built is not None and not np.array_equal(built.coords, self.document.model.coords)
-        self.plotter.render()
         self.updated.emit()
 
-    def _build(self) -> None:
-        from core.surfaces.levelled import build_surface  # the surface code loads with the first surface
-
-        structure, kind = self.document.structure, self.kind
+    def _start(self) -> None:
         coords = self.document.model.coords.copy()
-        atoms = dataclasses.replace(structure.atoms, coords=coords)
-        self._pending.add(kind)
-        future = self._executor.submit(build_surface, kind, atoms)
-        future.add_done_callback(lambda done: self._report(done, structure, kind, coords))
+        build = SurfaceBuild(self.kind, dataclasses.replace(self.document.structure.atoms, coords=coords))
+        notifier = QSocketNotifier(build.fileno(), QSocketNotifier.Type.Read, self)
+        notifier.activated.connect(lambda: self._receive(build))
+        self._running = _Running(build, notifier, coords)
 
-    def _report(self, done: Future, structure: Structure, kind: str, coords: np.ndarray) -> None:
-        """Runs in the worker thread: hand the result to the GUI thread."""
-        if not done.cancelled():
-            self._finished.emit(structure, kind, coords, done.exception() or done.result())
-
-    def _on_finished(self, structure: Structure, kind: str, coords: np.ndarray, result: object) -> None:
-        if structure is not self._structure:
-            return  # built for a structure no longer open
-        self._pending.discard(kind)
-        if isinstance(result, (ValueError, MemoryError)):
-            self._failed[kind] = f"{KIND_NAMES[kind]}: {result}"
-        elif isinstance(result, BaseException):
-            raise result
+    def _receive(self, build: SurfaceBuild) -> None:
+        """A message from the build: a stage, or the end."""
+        running = self._running
+        if running is None or running.build is not build:
+            return  # stopped while the message was on its way
+        message = build.receive()
+        if isinstance(message, str):
+            running.stage = message
+            self.updated.emit()
+            return
+        self._stop()
+        if isinstance(message, Exception):
+            self._failed[build.kind] = f"{KIND_NAMES[build.kind]}: {message}"
         else:
-            self._cache[kind] = Built(result, coords)
-        if kind == self.kind:
-            self._update()
+            self._cache[build.kind] = Built(message, running.coords)
+        self._update()
+
+    def _stop(self) -> None:
+        """Kill the running build, if any."""
+        if self._running is not None:
+            self._running.notifier.setEnabled(False)
+            self._running.notifier.deleteLater()
+            self._running.build.close()
+            self._running = None
 
     def _draw(self, surface: LevelledSurface) -> None:
         for colouring in dict.fromkeys((self.colouring, None)):  # plain when the colouring fails
@@ -243,9 +264,9 @@ class SurfaceLayer(QObject):
         self.mesh = self.actor = self._drawn = None
         if self.document.structure is not self._structure:
             self._structure = self.document.structure
+            self._stop()
             self._cache.clear()
             self._failed.clear()
-            self._pending.clear()
         if self.visible:
             self._update()
 
@@ -275,10 +296,10 @@ class SurfacePanel(QWidget):
         self.opacity = QSlider(Qt.Orientation.Horizontal)
         self.opacity.setRange(0, 100)
         self.opacity.setValue(round(layer.opacity * 100))
-        self.busy = QProgressBar()
-        self.busy.setRange(0, 0)  # an indeterminate "working" bar
-        self.busy.setTextVisible(False)
         self.figures = QLabel()
+        """The figures of the surface shown, the stage of its build, or why it failed. No animated
+        "working" bar: with the OpenGL view in the window, each of its frames is composited
+        through OpenGL (1.5 of 2 cores with software OpenGL, taken from the build)."""
         self.figures.setWordWrap(True)
         self.stale_text = QLabel("Computed from the atoms before the last edits.")
         self.stale_text.setWordWrap(True)
@@ -295,7 +316,6 @@ class SurfacePanel(QWidget):
         form.addRow("Opacity", self.opacity)
         layout = QVBoxLayout(self)
         layout.addLayout(form)
-        layout.addWidget(self.busy)
         layout.addWidget(self.figures)
         layout.addWidget(self.stale_text)
         layout.addWidget(self.recompute)
@@ -311,10 +331,9 @@ class SurfacePanel(QWidget):
         self.refresh()
 
     def refresh(self) -> None:
-        """Show the layer's state: busy, level range, figures of the mesh, staleness."""
+        """Show the layer's state: the build's stage, level range, figures of the mesh, staleness."""
         layer = self.layer
         built = layer.built
-        self.busy.setVisible(layer.busy)
         self.stale_text.setVisible(layer.stale)
         self.recompute.setVisible(layer.stale)
         self.show_box.setEnabled(layer.document.model is not None)
@@ -329,7 +348,7 @@ class SurfacePanel(QWidget):
                 self.slider.setValue(round(layer.shown_level() * steps))
         self.slider.setEnabled(built is not None and built.surface.max_level > 0)
         if layer.busy:
-            self.figures.setText(f"Building the {KIND_NAMES[layer.kind].lower()}…")
+            self.figures.setText(f"Building the {KIND_NAMES[layer.kind].lower()}: {layer.stage}…")
         elif built is None:
             self.level_text.setText("")
             self.figures.setText(layer.message or "Not built yet: tick “Show surface”.")

@@ -1,6 +1,11 @@
-"""The surface panel in a real window under Xvfb: surfaces built off the GUI thread from the
-panel, levels and colourings shown in place, stale after edits, failures reported."""
+"""The surface panel in a real window under Xvfb: surfaces built in a process of their own from
+the panel, their stages shown, stopped at once when another kind or file is chosen or the window
+closes; levels and colourings shown in place, stale after edits, failures reported."""
 
+import multiprocessing
+import signal
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -64,9 +69,9 @@ def test_globe_levels_colourings_and_screenshot(qtbot: QtBot, ubiquitin: Documen
     assert "surface" not in window.plotter.actors
     panel.kind.setCurrentIndex(list(KIND_NAMES).index("globe"))
     panel.show_box.setChecked(True)
-    assert panel.layer.busy and not panel.busy.isHidden()  # built off the GUI thread, with a busy bar
+    assert panel.layer.busy and panel.figures.text() == "Building the globe: starting…"  # in another process
     qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
-    assert panel.busy.isHidden()
+    assert "Building" not in panel.figures.text()
     surface = panel.layer.built.surface
     assert surface.kind == "globe" and surface.max_level == 5
     assert panel.slider.maximum() == 5 * STEPS_PER_LEVEL and panel.slider.value() == 5 * STEPS_PER_LEVEL
@@ -182,3 +187,64 @@ def test_failures_are_reported_and_a_new_file_drops_the_cache(qtbot: QtBot, ubiq
     ca = window.document.model.coords[window.document.ca_rows]
     assert np.linalg.norm(vertices.mean(axis=0) - ca.mean(axis=0)) < 5.0  # around the new structure
     assert window.plotter.actors["surface"].GetVisibility()
+
+
+def _building(qtbot: QtBot, window: MainWindow, kind: str, stage: str) -> multiprocessing.Process:
+    """Start building ``kind`` from the panel; return the build's process once it reports ``stage``."""
+    panel = window.surface_panel
+    panel.kind.setCurrentIndex(list(KIND_NAMES).index(kind))
+    panel.show_box.setChecked(True)
+    qtbot.waitUntil(lambda: panel.layer.stage.startswith(stage), timeout=BUILD_TIMEOUT_MS)
+    [process] = multiprocessing.active_children()
+    return process
+
+
+def test_the_stages_of_a_build_are_shown(qtbot: QtBot, ubiquitin: Document) -> None:
+    window = _window(qtbot, ubiquitin)
+    panel = window.surface_panel
+    shown: list[str] = []
+    panel.layer.updated.connect(lambda: shown.append(panel.figures.text()))
+    _show(qtbot, panel, "globe")
+    stages = [text.removeprefix("Building the globe: ") for text in dict.fromkeys(shown) if text.startswith("Building")]
+    ses = [f"molecular surface ({stage})…" for stage in
+           ("distances to the atoms", "the solvent", "distance transform", "refinement")]
+    assert stages == ["starting…", *ses, "fitting the globe…", "levels…"]
+    assert "triangles, " in shown[-1]
+
+
+def test_quitting_stops_a_running_build_at_once(qtbot: QtBot, open_window: Callable[[str], MainWindow]) -> None:
+    window = open_window("4YVS.cif.gz")  # 3,405 residues: a globe takes 10-20 s
+    process = _building(qtbot, window, "globe", "molecular surface (distance transform)")  # one long call into scipy
+    start = time.perf_counter()
+    window.quit_action.trigger()
+    seconds = time.perf_counter() - start
+    assert not window.isVisible() and seconds < 0.5
+    assert process.exitcode == -signal.SIGKILL and not multiprocessing.active_children()
+
+
+def test_another_kind_stops_the_running_build(qtbot: QtBot, open_window: Callable[[str], MainWindow]) -> None:
+    window = open_window("1AYE.pdb.gz")  # 401 residues: a globe takes 2-5 s, a density map a fraction of a second
+    panel = window.surface_panel
+    globe = _building(qtbot, window, "globe", "molecular surface")
+    panel.kind.setCurrentIndex(list(KIND_NAMES).index("map"))
+    assert globe.exitcode == -signal.SIGKILL
+    assert panel.layer.busy and panel.figures.text().startswith("Building the density map")
+    qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
+    assert panel.layer.built.surface.kind == "map" and window.plotter.actors["surface"].GetVisibility()
+    panel.kind.setCurrentIndex(list(KIND_NAMES).index("globe"))
+    assert panel.layer.built is None and panel.layer.busy  # the stopped globe left nothing: built again
+    qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
+    assert panel.layer.built.surface.kind == "globe"
+
+
+def test_opening_another_file_drops_the_running_build(qtbot: QtBot, open_window: Callable[[str], MainWindow]) -> None:
+    window = open_window("1AYE.pdb.gz")
+    panel = window.surface_panel
+    old = _building(qtbot, window, "globe", "molecular surface")
+    window.open_file(DATA / "1L2Y.pdb.gz")  # Trp-cage, 20 residues
+    assert old.exitcode == -signal.SIGKILL
+    [new] = multiprocessing.active_children()
+    qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
+    assert not new.is_alive() and panel.layer.built.surface.kind == "globe"
+    ca = window.document.model.coords[window.document.ca_rows]
+    assert np.linalg.norm(_actor_mesh(window).points.mean(axis=0) - ca.mean(axis=0)) < 5.0  # around the Trp-cage
