@@ -19,9 +19,11 @@ DAMPING = 1e-2
 STALL = 3e-3
 """Stop when nothing would be flagged, or anyway when a step is predicted to lower the
 objective by less than this fraction."""
-MAX_ITERATIONS = 25
-"""Levenberg–Marquardt steps at most per fit (typically 4–14 are taken; edits that have
-not settled by then are over-constrained, and more steps rarely remove a flag)."""
+MAX_ITERATIONS = 60
+"""Levenberg–Marquardt steps at most per fit: a drag typically takes 4–14 (one that has
+not settled by 25 is over-constrained, and more steps rarely remove a flag); a whole chain
+moved by a fit onto another conformation, every side chain checked for clashes, takes
+40–45 and settles only with them."""
 
 
 class State(Protocol):

@@ -35,6 +35,11 @@ MAX_INPUT_MB = 4096
 LIMIT_VARIABLE = "RIBBONWAVE_MAX_INPUT_MB"
 _BACKBONE = ("N", "CA", "C", "O")
 _PEPTIDE = (gemmi.PolymerType.PeptideL, gemmi.PolymerType.PeptideD)
+_POLYMER_ELEMENTS = frozenset({"H", "D", "C", "N", "O", "S", "P", "Se"})
+"""The elements of standard amino acids and nucleotides. A file without element columns
+(CHARMM and NAMD write such) leaves gemmi to guess from names: CA as calcium, HG1 as mercury."""
+_CHARMM_HISTIDINES = frozenset({"HSD", "HSE", "HSP"})
+"""CHARMM's names of histidine by protonation, standard residues by another name."""
 
 
 def read_structure(
@@ -321,6 +326,16 @@ class ScannedModel:
     n_altloc: int
 
 
+def _element(atom: gemmi.Atom, standard: bool) -> str:
+    """The atom's element; in a standard residue, the first letter of its name where the
+    element gemmi gives is none of a standard residue's (a guess from a name, as above)."""
+    name = atom.element.name
+    if not standard or name in _POLYMER_ELEMENTS:
+        return name
+    letters = atom.name.lstrip("0123456789")  # 1HB, 2HG1: older PDB hydrogen names
+    return letters[:1].upper() if letters[:1].upper() in _POLYMER_ELEMENTS else name
+
+
 def scan_model(model: gemmi.Model) -> ScannedModel:
     """Walk the model once (chain, residue, atom) and collect everything needed."""
     xyz: list[tuple[float, float, float]] = []
@@ -329,9 +344,15 @@ def scan_model(model: gemmi.Model) -> ScannedModel:
     n_hetero = n_water = n_altloc = 0
     amino_acid: dict[str, bool] = {}
     nucleotide: dict[str, bool] = {}
+    standard: dict[str, bool] = {}
     for k, ch in enumerate(model):
         peptide_chain = ch.get_polymer().check_polymer_type() in _PEPTIDE
         for res in ch:
+            if res.name not in amino_acid:
+                tabulated = gemmi.find_tabulated_residue(res.name)
+                amino_acid[res.name] = tabulated.is_amino_acid()
+                nucleotide[res.name] = tabulated.is_nucleic_acid()
+                standard[res.name] = tabulated.is_standard() or res.name in _CHARMM_HISTIDINES
             first = len(xyz)
             bb = [-1, -1, -1, -1]
             conformer = ""
@@ -340,7 +361,7 @@ def scan_model(model: gemmi.Model) -> ScannedModel:
                 xyz.append((p.x, p.y, p.z))
                 alt = atom.altloc if atom.has_altloc() else ""
                 atom_name.append(atom.name)
-                element.append(atom.element.name)
+                element.append(_element(atom, standard[res.name]))
                 altloc.append(alt)
                 b_factor.append(atom.b_iso)
                 occupancy.append(atom.occ)
@@ -354,10 +375,6 @@ def scan_model(model: gemmi.Model) -> ScannedModel:
                 n_water += len(res)
             elif res.het_flag == "H":
                 n_hetero += len(res)
-            if res.name not in amino_acid:
-                tabulated = gemmi.find_tabulated_residue(res.name)
-                amino_acid[res.name] = tabulated.is_amino_acid()
-                nucleotide[res.name] = tabulated.is_nucleic_acid()
             polymer = res.entity_type == gemmi.EntityType.Polymer
             nucleic.append(polymer and nucleotide[res.name])
             water.append(res.is_water())

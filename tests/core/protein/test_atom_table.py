@@ -56,3 +56,16 @@ def test_read_atoms_reports_bad_files(tmp_path: Path) -> None:
     (tmp_path / "empty.pdb").write_text("")
     with pytest.raises(StructureError, match="empty file"):
         read_atoms(tmp_path / "empty.pdb")
+
+
+def test_elements_of_a_file_without_element_columns_follow_the_names() -> None:
+    """A CHARMM file (adenylate kinase, hydrogens, no element columns, HSD histidines): gemmi's
+    guesses from the names (CA calcium, HG1 mercury, CB unknown) are the standard residues'
+    elements again (files with element columns keep gemmi's: the test above)."""
+    atoms = read_structure(DATA / "1AKE_adk_closed.pdb.gz").atoms
+    model = gemmi.read_structure(str(DATA / "1AKE_adk_closed.pdb.gz"))[0]
+    guessed = Counter(cra.atom.element.name for cra in model.all())
+    assert guessed["Ca"] > 0 and guessed["Hg"] > 0 and guessed["X"] > 0
+    assert Counter(atoms.element.tolist()) == {"H": 1685, "C": 1040, "O": 320, "N": 289, "S": 7}
+    assert set(atoms.element[atoms.name == "CA"]) == {"C"} and set(atoms.element[atoms.name == "HG1"]) == {"H"}
+    assert set(atoms.element[atoms.resname == "HSD"]) == {"C", "N", "H", "O"}
