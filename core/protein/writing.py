@@ -134,6 +134,7 @@ def write_models(
         raise FileExistsError(f"{path}: refusing to overwrite an existing file")
     st = structure._template.clone()
     template = st[structure.model_number - 1].clone()
+    _set_elements(template, structure)
     for k in reversed(range(len(st))):
         del st[k]
     for number, coords in enumerate(frames, start=1):
@@ -191,7 +192,9 @@ def _output_format(path: Path) -> tuple[str, bool]:
 def _moved(structure: Structure, coords: np.ndarray) -> gemmi.Structure:
     """A copy of the parsed file with the atoms of the structure's model at ``coords``."""
     st = structure._template.clone()
-    _place(st[structure.model_number - 1], coords)
+    model = st[structure.model_number - 1]
+    _place(model, coords)
+    _set_elements(model, structure)
     return st
 
 
@@ -208,6 +211,18 @@ def _place(model: gemmi.Model, coords: np.ndarray) -> None:
         for res in ch:
             for atom in res:
                 atom.pos = gemmi.Position(*next(rows))
+
+
+def _set_elements(model: gemmi.Model, structure: Structure) -> None:
+    """Give ``model`` (the structure's, as parsed) the elements read (gemmi's guesses from
+    atom names corrected, see :mod:`core.protein.reading`), for the files gemmi writes."""
+    elements = iter(structure.atoms.element.tolist())
+    for ch in model:
+        for res in ch:
+            for atom in res:
+                element = next(elements)
+                if atom.element.name != element:
+                    atom.element = gemmi.Element(element)
 
 
 def _pdb_text(st: gemmi.Structure, structure: Structure, moved: bool) -> str:

@@ -567,7 +567,7 @@ PDB_GROUPS = ("MTRIX", "ORIGX", "SCALE", "LINK", "SSBOND", "CISPEP", "HET")
 
 def _atoms(path: Path) -> list[tuple]:
     st = gemmi.read_structure(str(path))
-    return [(m.num, ch.name, str(r.seqid), r.name, a.name, a.altloc, a.element.name, round(a.pos.x, 3),
+    return [(m.num, ch.name, str(r.seqid), r.name, a.name, a.altloc, round(a.pos.x, 3),
              round(a.pos.y, 3), round(a.pos.z, 3), round(a.occ, 2), round(a.b_iso, 2))
             for m in st for ch in m for r in ch for a in r]
 
@@ -579,7 +579,7 @@ def test_an_unmoved_structure_reads_back_record_by_record(tmp_path: Path, name: 
     s = read_structure(DATA / name)
     source = _atoms(DATA / name)
     cif = write_structure(s, s.coords, tmp_path / "out.cif")
-    assert _atoms(cif) == source
+    assert _atoms(cif) == source and np.array_equal(read_structure(cif).atoms.element, s.atoms.element)
     if s.source_format == "mmcif":
         assert cif.read_bytes() == gzip.decompress((DATA / name).read_bytes())
         return
@@ -588,7 +588,7 @@ def test_an_unmoved_structure_reads_back_record_by_record(tmp_path: Path, name: 
     except StructureError as error:
         assert "cannot" in str(error)  # a chain id PDB cannot hold: refused, not mangled
         return
-    assert _atoms(pdb) == source
+    assert _atoms(pdb) == source and np.array_equal(read_structure(pdb).atoms.element, s.atoms.element)
     original, written = text_of(name).splitlines(), pdb.read_text().splitlines()
     for group in PDB_GROUPS:
         def lines(text: list[str]) -> list[str]:
@@ -602,3 +602,16 @@ def test_ca_rows_point_at_the_backbone_ca() -> None:
         rows = ca_rows(structure)
         assert np.array_equal(structure.coords[rows], np.concatenate([s.ca for s in structure.segments]))
         assert set(structure.atoms.name[rows]) == {"CA"}
+
+
+def test_a_file_without_element_columns_is_converted_with_the_elements_read(tmp_path: Path) -> None:
+    """CHARMM's adenylate kinase has no element columns: written as mmCIF (gemmi writes it),
+    its Cα are carbon, not calcium, and its hydrogens hydrogen; written as PDB it stays as read."""
+    structure = read_structure(DATA / "1AKE_adk_closed.pdb.gz")
+    written = read_structure(write_structure(structure, structure.coords, tmp_path / "adk.cif"))
+    block = gemmi.cif.read(str(tmp_path / "adk.cif")).sole_block()
+    symbols = dict(zip(block.find_values("_atom_site.label_atom_id"), block.find_values("_atom_site.type_symbol")))
+    assert symbols["CA"] == "C" and symbols["HG1"] == "H" and symbols["CB"] == "C"
+    assert np.array_equal(written.atoms.element, structure.atoms.element)
+    pdb = write_structure(structure, structure.coords, tmp_path / "adk.pdb")
+    assert pdb.read_bytes() == gzip.decompress((DATA / "1AKE_adk_closed.pdb.gz").read_bytes())
