@@ -91,7 +91,7 @@ def analyze_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUTDIR",
                         help="folder for residues.csv, summary.csv, skipped.csv and fig7.png (created if needed)")
     parser.add_argument("--overwrite", action="store_true", help="replace those files if OUTDIR already has them")
-    parser.add_argument("--jobs", type=_positive_int, default=len(os.sched_getaffinity(0)), metavar="N",
+    parser.add_argument("--jobs", type=bounded(int, 1, 4096), default=len(os.sched_getaffinity(0)), metavar="N",
                         help="worker processes (default: all cores)")
     parser.add_argument("--scheduler", nargs="?", const="local", metavar="ADDRESS",
                         help="run on a Dask cluster (e.g. tcp://host:8786); without ADDRESS, a local cluster "
@@ -590,16 +590,6 @@ def _core_mask(chain: list[BackboneSegment], text: str) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number; got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1; got {value}")
-    return value
 
 
 def _chain_pair(text: str) -> tuple[str, str]:

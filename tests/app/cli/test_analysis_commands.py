@@ -159,7 +159,7 @@ def test_compare_a_distant_homologue_by_structure_or_by_sequence(capsys):
         (["analyze", "{tmp}", "-o", "{tmp}/out"], 1, "no structure files"),
         (["analyze", DATA / "1UBQ.pdb.gz", "-o", "{tmp}/out", "--fraction-step", "0"], 2, "must lie in [0.05, 30]"),
         (["analyze", DATA / "1UBQ.pdb.gz", "-o", "{tmp}/out", "--max-depth", "-2"], 2, "must lie in [0, 30]"),
-        (["analyze", DATA / "1UBQ.pdb.gz", "-o", "{tmp}/out", "--jobs", "0"], 2, "must be >= 1"),
+        (["analyze", DATA / "1UBQ.pdb.gz", "-o", "{tmp}/out", "--jobs", "0"], 2, "must lie in [1, 4096]; got 0"),
         (["analyze", DATA / "1UBQ.pdb.gz"], 2, "required: -o/--output"),
         (["analyze", DATA / "1UBQ.pdb.gz", "-o", DATA / "1UBQ.pdb.gz"], 1, "not a folder"),
     ],
