@@ -88,7 +88,7 @@ def run_fit(args: argparse.Namespace) -> int:
         "model": str(args.file), "target": str(args.to),
         "levels": [{"level": f.level, "control_points": f.control_points, measure: round(f.score, 4),
                     "seconds": round(f.seconds, 4)} for f in result.levels],
-        "dropped_levels": result.dropped, "regularized": args.regularize,
+        "dropped_levels": result.dropped, "regularized": args.regularize, "refined": bool(result.refinement),
         "validation": {kind: {"before": before[kind], "after": after[kind]} for kind, _ in CHECKED},
         "output": str(written),
     })
@@ -103,6 +103,8 @@ def run_fit(args: argparse.Namespace) -> int:
     if result.dropped:
         print(f"  levels {', '.join(map(str, result.dropped))} undone: the regularized model kept more bad peptide "
               "junctions than the input (the target's backbone differs at that detail)")
+    if result.refinement:
+        print(f"  refined: the side chains turned into the map, level {result.levels[-1].level} fitted again with them")
     done = "regularized" if args.regularize else "not regularized"
     changes = ", ".join(f"{before[k]} -> {after[k]} {label}" for k, label in CHECKED)
     print(f"{done}: {name} {final:.3f}{unit}; {changes}")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from PySide6.QtGui import QUndoCommand
@@ -13,15 +14,18 @@ if TYPE_CHECKING:
 
 
 class EditCommand(QUndoCommand):
-    """One edit of one segment (a whole drag): redo applies it, undo restores it exactly."""
+    """One step: the edit of one segment (a whole drag), or of several at once (a level of a
+    fit of a chain); redo applies them in turn, undo restores them exactly."""
 
-    def __init__(self, document: Document, edit: Edit, text: str) -> None:
+    def __init__(self, document: Document, edits: Edit | Sequence[Edit], text: str) -> None:
         super().__init__(text)
         self.document = document
-        self.edit = edit
+        self.edits = (edits,) if isinstance(edits, Edit) else tuple(edits)
 
     def redo(self) -> None:
-        self.document.apply_edit(self.edit)
+        for edit in self.edits:
+            self.document.apply_edit(edit)
 
     def undo(self) -> None:
-        self.document.revert_edit(self.edit)
+        for edit in reversed(self.edits):
+            self.document.revert_edit(edit)

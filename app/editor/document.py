@@ -16,7 +16,7 @@ with :attr:`read_only_reason`, and ``levelChanged``, ``segmentChanged``, ``picke
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
@@ -321,10 +321,11 @@ class Document(QObject):
         if not np.array_equal(edit.old_coords, edit.new_coords):
             self.undo_stack.push(EditCommand(self, edit, f"Regularize {self.residue_range(edit.residues)}"))
 
-    def push_applied(self, edit: Edit, text: str) -> None:
-        """Make ``edit``, which a fit already applied to the model, one undo step named ``text``."""
-        self._model.revert(edit)
-        self.undo_stack.push(EditCommand(self, edit, text))
+    def push_applied(self, edits: Sequence[Edit], text: str) -> None:
+        """Make ``edits``, which a fit already applied to the model, one undo step named ``text``."""
+        for edit in reversed(edits):
+            self._model.revert(edit)
+        self.undo_stack.push(EditCommand(self, edits, text))
 
     def apply_edit(self, edit: Edit) -> None:
         """Carry out ``edit`` (undo commands call this)."""
@@ -357,7 +358,7 @@ class Document(QObject):
     def recording(self) -> list[records.Record]:
         """The document as records: the file as read, every undo step, the current state."""
         stack = self.undo_stack
-        steps = [records.push(k, stack.text(k), stack.command(k).edit) for k in range(stack.count())]
+        steps = [records.push(k, stack.text(k), stack.command(k).edits) for k in range(stack.count())]
         return [records.header(self.path, self.kind.value, self.source, self.model_number), *steps,
                 records.Record("index", self.state())]
 
@@ -375,7 +376,7 @@ class Document(QObject):
                 for record in recording[1:]:
                     if record.kind == "push":
                         stack.setIndex(record.fields["at"])
-                        stack.push(EditCommand(self, records.edit_of(record), record.fields["text"]))
+                        stack.push(EditCommand(self, records.edits_of(record), record.fields["text"]))
                     elif record.kind == "index":
                         stack.setIndex(record.fields["index"])
                         files = view = record.fields

@@ -1,12 +1,17 @@
-"""Edit ▸ Fit to Map and Fit to Compared Structure: the edited segment moved onto a target at
-the level shown or coarse to fine (:mod:`core.fitting`), each level one undo step.
+"""Edit ▸ Fit to Map and Fit to Compared Structure: the edited chain (every segment of it)
+moved onto a target at the level shown or coarse to fine (:mod:`core.fitting`), as
+``ribbonwave fit`` moves it, each level one undo step.
 
 The fit runs on the GUI thread, level by level. Between its steps it lets the event loop
 run, so the window repaints and the progress dialog's Cancel is heard, while that dialog,
-window-modal, keeps other edits away. Each level's edit becomes an undo step as soon as the
-level is done, so the view follows the fit; after coarse to fine the residues that moved are
-regularized as after a drag (:func:`core.fitting.conformation.regularize_fit`), one more
-step. Cancel undoes the level under way and keeps the levels done.
+window-modal, keeps other edits away. Each level's edits (one per segment) become one undo
+step as soon as the level is done, so the view follows the fit. After coarse to fine the
+fit settles as on the command line (:func:`core.fitting.settle.settle`): the residues that
+moved are regularized as after a drag, one more step, and where that leaves more bad
+peptide junctions than the file had, the finest level's step is undone and the rest
+regularized again. A map fit is then refined (:func:`core.fitting.density.refine`: the side
+chains turned into the map, the finest level fitted again), one more step. Cancel undoes
+the level under way and keeps the steps done.
 """
 
 from __future__ import annotations
@@ -22,43 +27,56 @@ from app.editor.document import Document
 from app.editor.scene.overlay import Compared, chain_segments
 from core.fitting.coarse_to_fine import LevelFit, fit_levels
 from core.fitting.conformation import SAME_FOLD, fold_similarity, pair_segments
-from core.fitting.density import MapTarget, fit_map_levels, heavy_atoms
-from core.fitting.settle import regularize_fit
+from core.fitting.density import MapTarget, fit_map_levels, heavy_atoms, refine
+from core.fitting.settle import settle
+from core.protein.model import Edit
 from core.surfaces.volume import DensityMap
 
 Fits = Callable[[Sequence[int], Callable[[], bool]], Iterator[LevelFit]]
-"""Fits the edited segment at the given levels, asking the callable whether to stop."""
+"""Fits the edited chain at the given levels, asking the callable whether to stop."""
+Refines = Callable[[int, Callable[[], bool]], list[Edit]]
+"""Refines a settled fit whose finest level is the given one: the edits, applied."""
 
 
 @dataclass(frozen=True)
 class FitTarget:
-    """What the edited segment is fitted to, and how to say how well it fits."""
+    """What the edited chain is fitted to, and how to say how well it fits."""
 
     name: str
     """As the undo steps name it: ``'map'``, ``'4AKE A'``."""
     fits: Fits
     score: Callable[[float], str]
     """A level's score for people: ``'CC 0.953'``, ``'Cα rmsd 1.21 Å'``."""
+    refine: Refines | None = None
+    """For a map: the side chains turned into it and the finest level fitted again."""
+
+
+def edited_chain(document: Document) -> list[int]:
+    """The segments of the edited segment's chain, in order: those a fit moves."""
+    segments = document.structure.segments
+    chain = segments[document.segment].chain
+    return [k for k, segment in enumerate(segments) if segment.chain == chain]
 
 
 def map_target(document: Document, density: DensityMap, resolution: float) -> FitTarget:
     """The map as target, the model's density blurred to ``resolution`` Å (raises
     :class:`core.surfaces.volume.MapError` where the map does not overlap the model)."""
-    model, segment = document.model, document.segment
+    model, segments = document.model, edited_chain(document)
     target = MapTarget(density, resolution, model.coords[heavy_atoms(model)])
-    return FitTarget("map", lambda levels, cancelled: fit_map_levels(model, [segment], target, levels,
+    return FitTarget("map", lambda levels, cancelled: fit_map_levels(model, segments, target, levels,
                                                                        cancelled=cancelled),
-                     lambda cc: f"CC {cc:.3f}")
+                     lambda cc: f"CC {cc:.3f}",
+                     lambda level, cancelled: refine(model, segments, target, level, cancelled=cancelled))
 
 
 def compared_target(document: Document, compared: Compared) -> FitTarget:
     """A compared structure's chain as target, its residues paired as Compare pairs them
     (raises ValueError for too few pairs or another fold)."""
     model = document.model
-    pairs, used = pair_segments(model, [document.segment], chain_segments(compared.structure, compared.chain))
+    pairs, used = pair_segments(model, edited_chain(document), chain_segments(compared.structure, compared.chain))
     count = sum(len(p.residues) for p in pairs)
     if count < 3:
-        raise ValueError(f"only {count} residue pair(s) between the edited segment and {compared.name}: nothing to fit")
+        raise ValueError(f"only {count} residue pair(s) between the edited chain and {compared.name}: nothing to fit")
     similarity = fold_similarity(model, pairs)
     if similarity < SAME_FOLD:
         raise ValueError(f"{compared.name} is another fold (TM-score {similarity:.2f} < {SAME_FOLD} over {count} "
@@ -75,9 +93,10 @@ def levels_to_fit(document: Document, coarse_to_fine: bool) -> list[int]:
 
 
 def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent: QWidget) -> list[LevelFit]:
-    """Fit the edited segment to ``target`` at ``levels`` in turn (coarse first), each level
-    one undo step; after more than one level (not cancelled), regularize as one more step.
-    Shows a window-modal progress dialog with Cancel. Returns the levels kept."""
+    """Fit the edited chain to ``target`` at ``levels`` in turn (coarse first), each level
+    one undo step; after more than one level (not cancelled), settle and refine as the
+    module says, a step each. Shows a window-modal progress dialog with Cancel. Returns the
+    levels kept."""
     progress = QProgressDialog(f"Fitting to the {target.name} at level {levels[0]}…", "Cancel", 0, len(levels),
                                parent)
     progress.setWindowTitle(f"Fit to {target.name}")
@@ -89,6 +108,10 @@ def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent
         QApplication.processEvents()
         return progress.wasCanceled()
 
+    def undo(fit: LevelFit) -> None:  # a level the regularization cannot keep
+        if fit.edits:
+            document.undo_stack.undo()
+
     kept: list[LevelFit] = []
     try:
         for fit in target.fits(levels, cancelled):
@@ -96,19 +119,35 @@ def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent
                 for edit in reversed(fit.edits):
                     document.model.revert(edit)
                 break
-            for edit in fit.edits:
-                document.push_applied(edit, f"Fit to {target.name} at level {fit.level} ({target.score(fit.score)})")
+            if fit.edits:
+                document.push_applied(fit.edits, f"Fit to {target.name} at level {fit.level} "
+                                                 f"({target.score(fit.score)})")
             kept.append(fit)
             progress.setValue(len(kept))
             if len(kept) < len(levels):
                 progress.setLabelText(f"Level {fit.level}: {target.score(fit.score)}. Fitting at level "
                                       f"{levels[len(kept)]}…")
         if len(levels) > 1 and kept and not progress.wasCanceled():
-            progress.setLabelText("Regularizing…")
-            QApplication.processEvents()
-            for edit in regularize_fit(document.model, kept):
-                document.push_applied(edit, f"Regularize the fit to {target.name}")
+            kept = _settle(document, target, kept, progress, cancelled, undo)
     finally:
         progress.close()
         progress.deleteLater()
     return kept
+
+
+def _settle(document: Document, target: FitTarget, fits: list[LevelFit], progress: QProgressDialog,
+            cancelled: Callable[[], bool], undo: Callable[[LevelFit], None]) -> list[LevelFit]:
+    """Regularize (dropping the finest levels that leave bad junctions) and refine, a step each."""
+    progress.setLabelText("Regularizing…")
+    QApplication.processEvents()
+    result = settle(document.model, fits, cancelled=cancelled, undo=undo)
+    undone = f" (level {', '.join(map(str, result.dropped))} undone: bad peptide junctions)" if result.dropped else ""
+    if result.regularization:
+        document.push_applied(result.regularization, f"Regularize the fit to {target.name}{undone}")
+    if target.refine is not None and result.levels and not progress.wasCanceled():
+        progress.setLabelText(f"Turning the side chains into the {target.name}…")
+        refined = target.refine(result.levels[-1].level, cancelled)
+        if refined:
+            document.push_applied(refined, f"Refine the fit to {target.name} (side chains, level "
+                                           f"{result.levels[-1].level} again)")
+    return result.levels

@@ -373,7 +373,7 @@ class MainWindow(QMainWindow):
 
     def fit(self, target: str, coarse_to_fine: bool, levels: list[int] | None = None, *,
             raise_errors: bool = False) -> list[LevelFit]:
-        """Fit the edited segment to the ``'map'`` or the ``'compared'`` structure (the first
+        """Fit the edited chain to the ``'map'`` or the ``'compared'`` structure (the first
         shown) at ``levels`` (default: the level shown, or coarse to fine every level up to it),
         each level one undo step (see :mod:`app.editor.fitting`). Returns the levels fitted;
         what prevents a fit is said in a dialog (or raised as ValueError with ``raise_errors``)."""

@@ -122,17 +122,18 @@ class EditorAPI:
 
     def fit_to_map(self, levels: int | Sequence[int] | None = None, resolution: float | None = None
                    ) -> list[tuple[int, float]]:
-        """Fit the edited segment into the open map as Edit ▸ Fit to Map does: at level ``levels``
+        """Fit the edited chain into the open map as Edit ▸ Fit to Map does: at level ``levels``
         (an integer), at each of ``levels`` in turn, or (None) coarse to fine from level 0 up to
-        the one shown; each level one undo step, and a fit of more than one level regularized as
-        one more. ``resolution`` (Å) sets the map's resolution first. Returns each level fitted
-        and the correlation after it."""
+        the one shown; each level one undo step, and a fit of more than one level settled as
+        on the command line (regularized, the finest levels that leave bad junctions undone)
+        and refined (side chains), a step each. ``resolution`` (Å) sets the map's resolution
+        first. Returns each level kept and the correlation after it."""
         if resolution is not None:
             self._window.correlation.set_resolution(float(resolution))
         return self._fit("map", levels)
 
     def fit_to_compared(self, levels: int | Sequence[int] | None = None) -> list[tuple[int, float]]:
-        """Fit the edited segment onto the (first shown) compared structure as Edit ▸ Fit to
+        """Fit the edited chain onto the (first shown) compared structure as Edit ▸ Fit to
         Compared Structure does (``levels`` as for :meth:`fit_to_map`). Returns each level
         fitted and the Cα rmsd to the target after it (Å)."""
         return self._fit("compared", levels)

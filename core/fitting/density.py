@@ -11,13 +11,24 @@ At each level the unknowns are the level's control points of every fitted segmen
 :mod:`core.fitting.coarse_to_fine`; L-BFGS maximises the CC less the energy of an elastic
 network of the Cα (which keeps the chain from molding itself into any density), each
 evaluation remapping the residues exactly, the gradient taking each residue's atoms to
-move with its curve point (the turn of its frame left out).
+move with its curve point (the turn of its frame left out). Each level is fitted twice,
+with two networks on the same springs: a harmonic one, which keeps the domains as they
+were, and one whose springs give way past :data:`GIVE_WAY` Å (the energy grows only as the
+logarithm of the stretch beyond it), as contacts between domains break when they part; the
+level keeps the fit the map correlates with better.
+
+After the levels and the regularization (:func:`~core.fitting.settle.settle`), the fit is
+refined (:func:`refine`): the side chains turn into the map
+(:func:`core.fitting.side_chains.fit_side_chains`), and the finest level is fitted again
+with them and regularized, twice: the regularization, which costs the correlation a little
+each time, costs less as the model settles.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator, Sequence
+from dataclasses import replace
 
 import numpy as np
 from scipy import ndimage, optimize
@@ -25,7 +36,8 @@ from scipy.spatial import cKDTree
 
 from core.curves.splines import spline_space
 from core.fitting.coarse_to_fine import LevelFit, pushed_to_finest
-from core.fitting.settle import FitResult, settle
+from core.fitting.settle import FitResult, regularize_fit, settle
+from core.fitting.side_chains import fit_side_chains
 from core.protein.model import Edit, EditableModel
 from core.protein.structure import ca_rows
 from core.surfaces.volume import DensityMap, MapError
@@ -37,10 +49,14 @@ RESOLUTION = (2.0, 30.0)
 MIN_OVERLAP = 0.5
 """Fewest of the model's atoms that must lie inside the map."""
 ITERATIONS_PER_LEVEL = 60
-STIFFNESS = 0.003
+STIFFNESS = 0.01
 """CC per Å² of mean squared change of the elastic network's spring lengths."""
 ELASTIC_CUTOFF = 10.0
 """Å: Cα closer than this at the start are joined by springs."""
+REFINE_CYCLES = 2
+"""Rounds of :func:`refine`: the finest level fitted again with the side chains turned."""
+GIVE_WAY = 6.0
+"""Å: the change of length past which the springs of the yielding network give way."""
 
 
 def gaussian_sigma(resolution: float) -> float:
@@ -77,48 +93,67 @@ class MapTarget:
         values = ndimage.map_coordinates(density.values.astype(np.float64), index.T, order=1, mode="nearest")
         values = values.reshape(self.shape)
         self._target = values - values.mean()
-        self._target_norm = float(np.linalg.norm(self._target))
+        self._target_norm = _norm(self._target)
         if self._target_norm == 0.0:
             raise MapError("the map is flat around the model: nothing to fit into")
 
     def density(self, coords: np.ndarray) -> np.ndarray:
         """The model's density on the grid for atoms at ``coords`` (n, 3)."""
-        spread = np.zeros(self.shape)
-        index = (coords - self.origin) / self.spacing
-        base = np.floor(index).astype(int)
-        frac = index - base
-        for corner in np.ndindex(2, 2, 2):
-            weight = np.prod(np.where(corner, frac, 1.0 - frac), axis=1)
-            at = base + corner
-            keep = np.all((at >= 0) & (at < self.shape), axis=1)
-            np.add.at(spread, tuple(at[keep].T), weight[keep])
-        return ndimage.gaussian_filter(spread, self.sigma / self.spacing, mode="constant", truncate=3.0)
+        flat, keep, weight, _ = self._corners(coords)
+        spread = np.bincount(flat[keep], weight[keep], int(np.prod(self.shape)))
+        return self._blur(spread.reshape(self.shape))
 
     def correlation(self, coords: np.ndarray) -> float:
         """CC about the mean of the model's density with the map."""
         model = self.density(coords)
         model -= model.mean()
-        norm = float(np.linalg.norm(model))
+        norm = _norm(model)
         return float(np.sum(model * self._target) / (norm * self._target_norm)) if norm > 0 else 0.0
 
     def gradient(self, coords: np.ndarray) -> tuple[float, np.ndarray]:
-        """The CC and its gradient (n, 3) with respect to each atom's position (1/Å)."""
+        """The CC and its gradient (n, 3) with respect to each atom's position (1/Å).
+
+        The density spreads each atom trilinearly and blurs; both are adjoint to what the
+        gradient does (the blur is symmetric, trilinear spreading the transpose of trilinear
+        interpolation), so the exact gradient is that of the trilinear interpolant of the
+        blurred ∂CC/∂density at each atom."""
         model = self.density(coords)
         model -= model.mean()
-        norm = float(np.linalg.norm(model))
+        norm = _norm(model)
         if norm == 0.0:
             return 0.0, np.zeros_like(coords)
         cc = float(np.sum(model * self._target) / (norm * self._target_norm))
-        field = self._target / (norm * self._target_norm) - cc * model / norm**2  # dCC / d(model density)
-        index = ((coords - self.origin) / self.spacing).T
-        sigma = self.sigma / self.spacing
-        gradient = np.empty_like(coords)
-        for axis in range(3):
-            order = [0, 0, 0]
-            order[axis] = 1
-            derivative = ndimage.gaussian_filter(field, sigma, order=order, mode="constant", truncate=3.0)
-            gradient[:, axis] = ndimage.map_coordinates(derivative, index, order=1, mode="constant") / self.spacing
-        return cc, gradient
+        field = self._blur(self._target / (norm * self._target_norm) - cc * model / norm**2).ravel()
+        flat, keep, _, slopes = self._corners(coords)
+        return cc, np.einsum("cn,cni->ni", np.where(keep, field[flat], 0.0), slopes) / self.spacing
+
+    def _blur(self, grid: np.ndarray) -> np.ndarray:
+        return ndimage.gaussian_filter(grid, self.sigma / self.spacing, mode="constant", truncate=3.0)
+
+    def _corners(self, coords: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """For the 8 grid corners around every atom: the flat index of the corner (8, n),
+        whether it lies on the grid (8, n), the trilinear weight (8, n) and its derivative
+        with respect to the atom's grid coordinates (8, n, 3)."""
+        index = (coords - self.origin) / self.spacing
+        base = np.floor(index).astype(int)
+        frac = index - base
+        factors = np.where(_CORNERS[:, None], frac, 1.0 - frac)  # (8, n, 3)
+        sign = np.where(_CORNERS, 1.0, -1.0)[:, None]
+        x, y, z = factors[..., 0], factors[..., 1], factors[..., 2]
+        slopes = np.stack([sign[..., 0] * y * z, x * sign[..., 1] * z, x * y * sign[..., 2]], axis=-1)
+        at = base + _CORNERS[:, None]
+        keep = np.all((at >= 0) & (at < self.shape), axis=2)
+        flat = np.where(keep, (at[..., 0] * self.shape[1] + at[..., 1]) * self.shape[2] + at[..., 2], 0)
+        return flat, keep, x * y * z, slopes
+
+
+def _norm(grid: np.ndarray) -> float:
+    """The 2-norm of a grid (as a sum: BLAS's, through np.linalg.norm, is slow with its threads busy)."""
+    return float(np.sqrt(np.sum(grid * grid)))
+
+
+_CORNERS = np.array(list(np.ndindex(2, 2, 2)))
+"""The 8 corners of a grid cell, (8, 3) of 0 or 1."""
 
 
 def heavy_atoms(model: EditableModel) -> np.ndarray:
@@ -127,14 +162,30 @@ def heavy_atoms(model: EditableModel) -> np.ndarray:
     return np.flatnonzero(~np.isin(np.char.upper(atoms.element.astype(str)), ("H", "D")) & (atoms.category != "water"))
 
 
-class ElasticNetwork:
-    """Springs between Cα closer than ``cutoff`` (Å) at rest: the energy, mean squared
-    change of their lengths (Å²), keeps the fit from molding a chain into any density."""
+def atom_correlation(model: EditableModel, target: MapTarget) -> Callable[[np.ndarray], tuple[float, np.ndarray]]:
+    """The CC of ``model``'s heavy atoms with ``target`` as a function of all its
+    coordinates: the CC and its gradient (n_atoms, 3), zero for the other atoms."""
+    rows = heavy_atoms(model)
 
-    def __init__(self, ca: np.ndarray, cutoff: float = ELASTIC_CUTOFF) -> None:
+    def correlation(coords: np.ndarray) -> tuple[float, np.ndarray]:
+        cc, gradient = target.gradient(coords[rows])
+        total = np.zeros_like(coords)
+        total[rows] = gradient
+        return cc, total
+    return correlation
+
+
+class ElasticNetwork:
+    """Springs between Cα closer than ``cutoff`` (Å) at rest: the energy, the mean over the
+    springs of the squared change ``s`` of their lengths (Å²), keeps the fit from molding a
+    chain into any density. With ``give_way`` (Å) each spring's energy is
+    ``g² log(1 + s²/g²)`` instead: the same for small changes, far less for large ones."""
+
+    def __init__(self, ca: np.ndarray, cutoff: float = ELASTIC_CUTOFF, give_way: float | None = None) -> None:
         pairs = cKDTree(ca).query_pairs(cutoff, output_type="ndarray")
         self.i, self.j = pairs[:, 0], pairs[:, 1]
         self.rest = np.linalg.norm(ca[self.i] - ca[self.j], axis=1)
+        self.give_way = give_way
 
     def gradient(self, ca: np.ndarray) -> tuple[float, np.ndarray]:
         """The energy and its gradient (n, 3) with respect to each Cα."""
@@ -142,11 +193,16 @@ class ElasticNetwork:
         length = np.linalg.norm(vector, axis=1)
         stretch = length - self.rest
         n = max(len(stretch), 1)
-        force = (2.0 / n) * (stretch / np.maximum(length, 1e-9))[:, None] * vector
+        if self.give_way is None:
+            energy, slope = stretch**2, 2.0 * stretch
+        else:
+            ratio = (stretch / self.give_way) ** 2
+            energy, slope = self.give_way**2 * np.log1p(ratio), 2.0 * stretch / (1.0 + ratio)
+        force = (slope / (n * np.maximum(length, 1e-9)))[:, None] * vector
         gradient = np.zeros_like(ca)
         np.add.at(gradient, self.i, force)
         np.add.at(gradient, self.j, -force)
-        return float(np.sum(stretch**2) / n), gradient
+        return float(np.sum(energy) / n), gradient
 
 
 def fit_map_levels(
@@ -156,30 +212,36 @@ def fit_map_levels(
     levels: Sequence[int],
     *,
     stiffness: float = STIFFNESS,
+    give_way: float | None = GIVE_WAY,
     cancelled: Callable[[], bool] = lambda: False,
 ) -> Iterator[LevelFit]:
     """Fit ``model``'s ``segments`` into ``target`` at each of ``levels`` in turn (coarse
     first), applying each level's edits to ``model`` and yielding them; a level's score is
     the CC after it. The objective is the CC less ``stiffness`` times the energy of an
-    elastic network of the Cα as they are at the start (:class:`ElasticNetwork`)."""
-    rows = heavy_atoms(model)
+    elastic network of the Cα as they are at the start (:class:`ElasticNetwork`), harmonic
+    or giving way past ``give_way`` Å, whichever fits the level better (harmonic alone
+    without ``give_way``)."""
+    correlation = atom_correlation(model, target)
     ca = ca_rows(model.structure)[np.concatenate([model.segments[s].residue_index for s in segments])]
-    network = ElasticNetwork(model.coords[ca])
+    networks = [ElasticNetwork(model.coords[ca], give_way=g) for g in dict.fromkeys((None, give_way))]
 
-    def evaluate(coords: np.ndarray) -> tuple[float, float, np.ndarray]:
-        """The objective, the CC and the objective's gradient per atom at ``coords``."""
-        cc, gradient = target.gradient(coords[rows])
-        energy, pull = network.gradient(coords[ca])
-        total = np.zeros((model.structure.n_atoms, 3))
-        total[rows] = gradient
-        total[ca] -= stiffness * pull
-        return cc - stiffness * energy, cc, total
+    def objective(network: ElasticNetwork) -> Callable[[np.ndarray], tuple[float, float, np.ndarray]]:
+        def evaluate(coords: np.ndarray) -> tuple[float, float, np.ndarray]:
+            """The objective, the CC and the objective's gradient per atom at ``coords``."""
+            cc, total = correlation(coords)
+            energy, pull = network.gradient(coords[ca])
+            total[ca] -= stiffness * pull
+            return cc - stiffness * energy, cc, total
+        return evaluate
 
     for level in levels:
         if cancelled():
             return
         start = time.perf_counter()
-        cc, planned = _fit_level(model, segments, level, lambda coords: evaluate(coords), cancelled)
+        cc, planned = max((_fit_level(model, segments, level, objective(network), cancelled) for network in networks),
+                          key=lambda fit: fit[0])
+        if cancelled():
+            return
         for edit in planned:
             model.apply(edit)
         n_points = sum(spline_space(min(level, model.ribbons[s].level)).n_points for s in segments)
@@ -250,7 +312,52 @@ def fit_map(
     regularize: bool = True,
     cancelled: Callable[[], bool] = lambda: False,
 ) -> FitResult:
-    """Fit ``model``'s ``segments`` into ``target`` at ``levels`` (coarse first), then
-    :func:`~core.fitting.settle.settle` it; every edit kept is applied to ``model``."""
+    """Fit ``model``'s ``segments`` into ``target`` at ``levels`` (coarse first),
+    :func:`~core.fitting.settle.settle` it, then :func:`refine` it; every edit kept is
+    applied to ``model``."""
     fits = list(fit_map_levels(model, segments, target, levels, cancelled=cancelled))
-    return settle(model, fits, regularize=regularize, cancelled=cancelled)
+    result = settle(model, fits, regularize=regularize, cancelled=cancelled)
+    if not result.levels:
+        return result
+    refined = refine(model, segments, target, result.levels[-1].level, regularize=regularize, cancelled=cancelled)
+    return replace(result, refinement=refined)
+
+
+def refine(
+    model: EditableModel,
+    segments: Sequence[int],
+    target: MapTarget,
+    level: int,
+    *,
+    cycles: int = REFINE_CYCLES,
+    regularize: bool = True,
+    cancelled: Callable[[], bool] = lambda: False,
+) -> list[Edit]:
+    """After the levels: turn the side chains into the map
+    (:func:`~core.fitting.side_chains.fit_side_chains`), then ``cycles`` times fit ``level``
+    again with them, regularize what that moved and turn the side chains again (the backbone
+    settles into the map as the side chains do, and the regularization costs less each time).
+    Returns the edits, applied, one per segment."""
+    correlation = atom_correlation(model, target)
+    done: dict[int, Edit] = {}
+
+    def record(edits: Sequence[Edit]) -> None:
+        for edit in edits:
+            done[edit.segment] = done[edit.segment].then(edit) if edit.segment in done else edit
+
+    def turn_side_chains() -> None:
+        turned = fit_side_chains(model, segments, correlation, cancelled=cancelled)
+        for edit in turned:
+            model.apply(edit)
+        record(turned)
+
+    turn_side_chains()
+    for _ in range(cycles):
+        if cancelled():
+            break
+        again = list(fit_map_levels(model, segments, target, [level], give_way=None, cancelled=cancelled))
+        record([edit for fit in again for edit in fit.edits])
+        if regularize:
+            record(regularize_fit(model, again))
+        turn_side_chains()
+    return list(done.values())

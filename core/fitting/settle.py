@@ -4,7 +4,7 @@ finest level whose regularized model has no more bad peptide junctions than the 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -26,11 +26,14 @@ class FitResult:
     dropped : levels fitted but undone: the regularized model of each left more bad
         peptide junctions than the input had (finer levels bent the backbone to a shape
         its residues cannot take, as when the target is another protein).
+    refinement : what followed, one edit per segment (for a map: the side chains turned into
+        it and the finest level fitted again, :func:`core.fitting.density.refine`).
     """
 
     levels: list[LevelFit]
     regularization: list[Edit]
     dropped: list[int]
+    refinement: list[Edit] = field(default_factory=list)
 
 
 BACKBONE = ("peptide_bond", "ca_ca")
@@ -38,10 +41,12 @@ BACKBONE = ("peptide_bond", "ca_ca")
 
 
 def settle(model: EditableModel, fits: list[LevelFit], *, regularize: bool = True,
-           cancelled: Callable[[], bool] = lambda: False) -> FitResult:
+           cancelled: Callable[[], bool] = lambda: False,
+           undo: Callable[[LevelFit], None] | None = None) -> FitResult:
     """With ``regularize``, regularize what ``fits`` (applied to ``model``) moved; while
     the regularized model has more bad peptide junctions than the input, undo the finest
-    level kept and try again."""
+    level kept (with ``undo``, where its edits are undo steps; else by reverting them) and
+    try again."""
     fits = list(fits)
     if not regularize:
         return FitResult(fits, [], [])
@@ -53,8 +58,11 @@ def settle(model: EditableModel, fits: list[LevelFit], *, regularize: bool = Tru
             return FitResult(fits, edits, dropped)
         for edit in reversed(edits):
             model.revert(edit)
-        for edit in reversed(fits[-1].edits):
-            model.revert(edit)
+        if undo is None:
+            for edit in reversed(fits[-1].edits):
+                model.revert(edit)
+        else:
+            undo(fits[-1])
         dropped.insert(0, fits.pop().level)
 
 

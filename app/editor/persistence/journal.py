@@ -116,7 +116,7 @@ class Journal(QObject):
         count = stack.count()  # a push replaces the commands above the position with one
         top = stack.command(count - 1) if count else None
         if count and (len(self._mirror) < count or self._mirror[count - 1] is not top):
-            entries.append(records.push(count - 1, top.text(), top.edit))
+            entries.append(records.push(count - 1, top.text(), top.edits))
             self._mirror[count - 1 :] = [top]
         del self._mirror[count:]
         state = document.state()

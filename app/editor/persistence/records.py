@@ -8,11 +8,11 @@ written as they are in memory, so coordinates come back bit for bit. A file cut 
 mid-record (a crash while writing) reads as the records before the damage.
 
 Kinds: ``header`` (format version, file name, ribbon kind, model, the file's bytes as read),
-``push`` (an undo step pushed at a stack position: its text and :class:`~core.protein.model.Edit`),
-``index`` (the stack position after a step, undo or redo, the clean position, the file
-names, the level, segment and multiresolution switch), ``state`` (level, segment and
-multiresolution switch alone) and ``view`` (session files: layers, camera, compared
-structures).
+``push`` (an undo step pushed at a stack position: its text and the
+:class:`~core.protein.model.Edit` of each segment it changed), ``index`` (the stack
+position after a step, undo or redo, the clean position, the file names, the level,
+segment and multiresolution switch), ``state`` (level, segment and multiresolution switch
+alone) and ``view`` (session files: layers, camera, compared structures).
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import struct
 import zlib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,9 +30,10 @@ from core.protein.model import Edit
 
 MAGIC = b"\x89RWAVE\r\n"
 """The first bytes of a journal or session file."""
-VERSION = 2
+VERSION = 3
 """Format version written; files of a newer version are refused with a message. Version 2
-added the model of the header (version 1 files hold model 1)."""
+added the model of the header (version 1 files hold model 1), version 3 steps of several
+segments (a push record of one segment is written as before)."""
 _FRAME = struct.Struct("<II")
 _EDIT_ARRAYS = ("old_points", "new_points", "residues", "rows", "old_coords", "new_coords")
 
@@ -109,15 +111,23 @@ def model_of(fields: dict) -> int:
     return fields.get("model", 1)
 
 
-def push(at: int, text: str, edit: Edit) -> Record:
-    """An undo step ``edit`` named ``text`` pushed with the stack at position ``at``."""
-    return Record("push", {"at": at, "text": text, "segment": edit.segment},
-                  {name: getattr(edit, name) for name in _EDIT_ARRAYS})
+def push(at: int, text: str, edits: Sequence[Edit]) -> Record:
+    """An undo step of ``edits`` named ``text`` pushed with the stack at position ``at``."""
+    if len(edits) == 1:
+        edit = edits[0]
+        return Record("push", {"at": at, "text": text, "segment": edit.segment},
+                      {name: getattr(edit, name) for name in _EDIT_ARRAYS})
+    return Record("push", {"at": at, "text": text, "segments": [edit.segment for edit in edits]},
+                  {f"{k}.{name}": getattr(edit, name) for k, edit in enumerate(edits) for name in _EDIT_ARRAYS})
 
 
-def edit_of(record: Record) -> Edit:
-    """The :class:`Edit` of a ``push`` record."""
-    return Edit(record.fields["segment"], *(record.arrays[name] for name in _EDIT_ARRAYS))
+def edits_of(record: Record) -> list[Edit]:
+    """The edits of a ``push`` record."""
+    fields, arrays = record.fields, record.arrays
+    if "segments" not in fields:
+        return [Edit(fields["segment"], *(arrays[name] for name in _EDIT_ARRAYS))]
+    return [Edit(segment, *(arrays[f"{k}.{name}"] for name in _EDIT_ARRAYS))
+            for k, segment in enumerate(fields["segments"])]
 
 
 def source_of(record: Record) -> bytes:

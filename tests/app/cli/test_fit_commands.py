@@ -96,7 +96,7 @@ def test_fit_into_a_map_raises_the_correlation_and_nears_the_target(capsys, tmp_
     status, text, _ = run(capsys, "fit", CLOSED, "--to", density, "--resolution", "10", "--levels", "0-5",
                           "-o", out, "--json")
     report = json.loads(text)
-    assert status == 0 and report["resolution"] == 10.0
+    assert status == 0 and report["resolution"] == 10.0 and report["refined"]
     cc = [level["cc"] for level in report["levels"]]
     assert cc[-1] > cc[0] and cc[-1] > 0.96 and report["final"] > 0.96
     fitted = read_structure(out)

@@ -98,7 +98,7 @@ def test_a_recording_replays_the_same_model_and_older_ones_read_as_model_1(qapp:
     document.set_regularization(on_release=False)
     _move(document)
     recording = document.recording()
-    assert recording[0].fields["model"] == 9 and recording[0].fields["version"] == records.VERSION == 2
+    assert recording[0].fields["model"] == 9 and recording[0].fields["version"] == records.VERSION == 3
     again = Document()
     again.replay(recording)
     assert again.model_number == 9 and np.array_equal(again.model.coords, document.model.coords)

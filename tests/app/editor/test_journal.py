@@ -86,7 +86,7 @@ def test_every_step_is_appended_as_a_delta(qtbot: QtBot, state_home: Path) -> No
     for k in range(3):
         _edit(window, 5 + k)
         sizes.append(path.stat().st_size)
-        edit = stack.command(stack.index() - 1).edit
+        edit, = stack.command(stack.index() - 1).edits
         arrays = sum(a.nbytes for a in (edit.old_points, edit.new_points, edit.residues, edit.rows, edit.old_coords,
                                         edit.new_coords))
         assert arrays < sizes[-1] - sizes[-2] < arrays + 1024  # the edit's deltas and a line of JSON

@@ -23,6 +23,7 @@ from app.editor.map_correlation import INTERVAL_MS
 from app.editor.scene.map_mesh import RECONTOUR_MS
 from core.analysis.superpose import superpose
 from core.fitting.density import gaussian_sigma
+from core.geometry.validation import validate
 from core.protein.reading import read_structure
 from core.protein.structure import ca_rows
 from core.surfaces.volume import DensityMap
@@ -32,12 +33,15 @@ CLOSED, OPEN = "1AKE_adk_closed.pdb.gz", "4AKE_adk_open.pdb.gz"
 RESOLUTION = 8.0
 
 
-def simulated_map(path: Path, resolution: float = RESOLUTION, spacing: float = 1.5) -> Path:
+def simulated_map(path: Path, resolution: float = RESOLUTION) -> Path:
     """Write the density of 4AKE's heavy atoms, superposed on 1AKE's Cα, at ``resolution`` Å."""
     closed, target = read_structure(DATA / CLOSED), read_structure(DATA / OPEN)
     fit = superpose(closed.coords[ca_rows(closed)], target.coords[ca_rows(target)])  # the same 214 residues
-    heavy = target.atoms.element != "H"
-    coords = fit.apply(target.coords[heavy])
+    return write_map(path, fit.apply(target.coords[target.atoms.element != "H"]), resolution)
+
+
+def write_map(path: Path, coords: np.ndarray, resolution: float, spacing: float = 1.5) -> Path:
+    """Write the density of atoms at ``coords`` at ``resolution`` Å as a CCP4 map."""
     origin = coords.min(axis=0) - 12.0
     shape = np.ceil((coords.max(axis=0) + 12.0 - origin) / spacing).astype(int)
     index = np.round((coords - origin) / spacing).astype(int)
@@ -169,13 +173,40 @@ def test_fit_to_map_coarse_to_fine_is_one_step_a_level_and_a_regularization(wind
     assert window.map_panel.resolution.value() == 8.5
     assert [level for level, _ in fitted] == [0, 1, 2, 3]
     steps, index = window.rw.history()
-    assert index == 5 and [s.split(" (")[0] for s in steps[:4]] == [f"Fit to map at level {k}" for k in range(4)]
+    assert index == 6 and [s.split(" (")[0] for s in steps[:4]] == [f"Fit to map at level {k}" for k in range(4)]
     assert steps[4] == "Regularize the fit to map"
+    assert steps[5] == "Refine the fit to map (side chains, level 3 again)"
     assert window.rw.map_correlation > cc + 0.1
     assert _ca_rmsd(window, target_ca) < rmsd - 2.0  # towards the open form whose map it is
-    for _ in range(5):
+    window.rw.undo()  # the refinement: the side chains turned back, the backbone as regularized
+    regularized = document.model.coords.copy()
+    window.rw.redo()
+    side_chain = ~np.isin(document.structure.atoms.name, ("N", "CA", "C", "O", "CB"))
+    assert np.abs(document.model.coords - regularized)[side_chain].max() > 1.0  # side chains turned
+    for _ in range(6):
         window.rw.undo()
     assert np.array_equal(document.model.coords, document.structure.coords)
+
+
+def test_a_fit_moves_every_segment_of_the_edited_chain_in_one_step_a_level(
+    open_window: Callable[[str], MainWindow], tmp_path: Path
+) -> None:
+    window = open_window("1F9V.pdb.gz")  # chain A in five segments (chain breaks)
+    document = window.document
+    structure = document.structure
+    shift = np.array([2.0, 0.0, 0.0])
+    window.rw.open_map(write_map(tmp_path / "1F9V_moved.ccp4", structure.coords[structure.atoms.element != "H"]
+                                 + shift, RESOLUTION))
+    window.map_panel.resolution.setValue(RESOLUTION)
+    document.set_level(1)
+    window.fit_actions[0].trigger()  # Edit ▸ Fit to Map at This Level
+    assert window.rw.history()[1] == 1  # one step
+    ca = ca_rows(structure)
+    for segment in structure.segments:
+        moved = document.model.coords[ca[segment.residue_index]] - structure.coords[ca[segment.residue_index]]
+        assert np.mean(moved @ shift) / 2.0 > 1.0  # every segment towards the map, not the edited one alone
+    window.rw.undo()
+    assert np.array_equal(document.model.coords, structure.coords)
 
 
 def test_cancel_stops_the_fit_after_the_level_under_way(window: MainWindow, qtbot: QtBot) -> None:
@@ -213,6 +244,23 @@ def test_fit_to_compared_structure_brings_the_ca_rmsd_down(open_window: Callable
     steps, index = window.rw.history()
     assert index == 8 and steps[-1] == "Regularize the fit to 4AKE_adk_open"
     assert rmsd > 6.0 and _ca_rmsd(window, target_ca) < 1.5
+
+
+def test_coarse_to_fine_undoes_the_finest_levels_a_homologue_cannot_take(
+    open_window: Callable[[str], MainWindow]
+) -> None:
+    window = open_window("3PTB.pdb.gz")  # trypsin, onto another serine protease's backbone
+    window.comparison.add(DATA / "3SGB.pdb.gz")
+    document = window.document
+    before = validate(document.structure).counts
+    fitted = window.rw.fit_to_compared()  # levels 0 to 6
+    steps, index = window.rw.history()
+    kept = [level for level, _ in fitted]
+    assert kept == list(range(len(kept))) and kept[-1] < 6  # as the command line: level 6 undone
+    assert index == len(kept) + 1 and steps[-1].startswith("Regularize the fit to 3SGB")
+    assert "6 undone" in steps[-1]
+    after = validate(document.structure, document.model.coords).counts
+    assert after["peptide_bond"] + after["ca_ca"] <= before["peptide_bond"] + before["ca_ca"]
 
 
 def test_fits_need_a_target(open_window: Callable[[str], MainWindow], errors: list[str]) -> None:
