@@ -60,6 +60,8 @@ MIN_RESIDUES = 20
 """Chains with fewer residues are not indexed (peptides have no fold to search)."""
 FORMAT = 1
 """Version of the index file."""
+SCREEN_STEP = 4
+"""The candidates of :func:`search` are screened by aligning every 4th Cα of each chain."""
 FIELDS = ("format", "entries", "chains", "paths", "lengths", "descriptors", "coordinates", "sequences")
 
 
@@ -200,9 +202,14 @@ class Hit:
     match: FoldMatch
 
 
-def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candidates: int = 20) -> list[Hit]:
+def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candidates: int = 60,
+           aligned: int = 15) -> list[Hit]:
     """The ``top`` chains of ``index`` of highest TM-score (normalised by the query) among the
     ``candidates`` nearest to the query's descriptor, best first.
+
+    The candidates are screened by the TM-score of the alignment of every
+    :data:`SCREEN_STEP`-th Cα of each chain (a small fraction of a full alignment's work),
+    and the best ``aligned`` of them (at least ``top``) aligned in full.
 
     Parameters
     ----------
@@ -210,14 +217,21 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candi
     """
     ca = np.asarray(ca, dtype=np.float64)
     distance = descriptor_distances(index.descriptors, curve_descriptor(ca))
-    nearest = np.argsort(distance, kind="stable")[:max(candidates, top)]
+    nearest = np.argsort(distance, kind="stable")[:max(candidates, aligned, top)].tolist()
+    coarse = ca[::SCREEN_STEP]
+    screened = [align_folds(coarse, index.chain(row)[0][::SCREEN_STEP]).tm_score
+                if len(coarse) >= MIN_RESIDUES // SCREEN_STEP and index.lengths[row] >= MIN_RESIDUES else 0.0
+                for row in nearest]
+    chosen = [nearest[k] for k in np.argsort(screened, kind="stable")[::-1][:max(aligned, top)]]
+    alignments = {row: align_folds(ca, index.chain(row)[0]) for row in chosen}
+    best = sorted(chosen, key=lambda row: -alignments[row].tm_score)[:top]
     names = np.frombuffer(sequence.encode("ascii", "replace"), dtype="S1")
     hits = []
-    for row in nearest.tolist():
+    for row in best:
         other, other_names = index.chain(row)
-        alignment = align_folds(ca, other)
+        alignment = alignments[row]
         match = fold_match(ca, other, alignment.pairs_a, alignment.pairs_b, names, other_names)
         hits.append(Hit(row, str(index.entries[row]), str(index.chains[row]), str(index.paths[row]),
                         int(index.lengths[row]), float(distance[row]), match))
     hits.sort(key=lambda hit: -hit.match.tm_score_a)
-    return hits[:top]
+    return hits

@@ -28,9 +28,9 @@ QUICK_DP_ROUNDS = 2
 """Rounds from the local superpositions and the fragment threading (TM-align's)."""
 GAP_OPEN = (-0.6, 0.0)
 """TM-align's two gap penalties of the rounds."""
-COARSE_FROM = 40
+COARSE_FROM = 80
 """Residues of the shorter chain from which the local superpositions are screened on every
-other residue (:func:`_local_superpositions`)."""
+other residue (every third from twice as many; :func:`_local_superpositions`)."""
 LOCAL_KEEP = 4
 """Local superpositions kept from that screen."""
 
@@ -47,29 +47,23 @@ def kabsch(x: np.ndarray, y: np.ndarray, rows: np.ndarray, count: int) -> tuple[
         cx0, cx1, cx2 = cx0 + x[r, 0], cx1 + x[r, 1], cx2 + x[r, 2]
         cy0, cy1, cy2 = cy0 + y[r, 0], cy1 + y[r, 1], cy2 + y[r, 2]
     cx0, cx1, cx2, cy0, cy1, cy2 = cx0 / count, cx1 / count, cx2 / count, cy0 / count, cy1 / count, cy2 / count
-    s = np.zeros((3, 3))
+    s00 = s01 = s02 = s10 = s11 = s12 = s20 = s21 = s22 = 0.0
     for k in range(count):
         r = rows[k]
         a0, a1, a2 = x[r, 0] - cx0, x[r, 1] - cx1, x[r, 2] - cx2
         b0, b1, b2 = y[r, 0] - cy0, y[r, 1] - cy1, y[r, 2] - cy2
-        s[0, 0] += a0 * b0
-        s[0, 1] += a0 * b1
-        s[0, 2] += a0 * b2
-        s[1, 0] += a1 * b0
-        s[1, 1] += a1 * b1
-        s[1, 2] += a1 * b2
-        s[2, 0] += a2 * b0
-        s[2, 1] += a2 * b1
-        s[2, 2] += a2 * b2
+        s00, s01, s02 = s00 + a0 * b0, s01 + a0 * b1, s02 + a0 * b2
+        s10, s11, s12 = s10 + a1 * b0, s11 + a1 * b1, s12 + a1 * b2
+        s20, s21, s22 = s20 + a2 * b0, s21 + a2 * b1, s22 + a2 * b2
     n = np.empty((4, 4))
-    n[0, 0], n[1, 1] = s[0, 0] + s[1, 1] + s[2, 2], s[0, 0] - s[1, 1] - s[2, 2]
-    n[2, 2], n[3, 3] = -s[0, 0] + s[1, 1] - s[2, 2], -s[0, 0] - s[1, 1] + s[2, 2]
-    n[0, 1] = n[1, 0] = s[1, 2] - s[2, 1]
-    n[0, 2] = n[2, 0] = s[2, 0] - s[0, 2]
-    n[0, 3] = n[3, 0] = s[0, 1] - s[1, 0]
-    n[1, 2] = n[2, 1] = s[0, 1] + s[1, 0]
-    n[1, 3] = n[3, 1] = s[2, 0] + s[0, 2]
-    n[2, 3] = n[3, 2] = s[1, 2] + s[2, 1]
+    n[0, 0], n[1, 1] = s00 + s11 + s22, s00 - s11 - s22
+    n[2, 2], n[3, 3] = -s00 + s11 - s22, -s00 - s11 + s22
+    n[0, 1] = n[1, 0] = s12 - s21
+    n[0, 2] = n[2, 0] = s20 - s02
+    n[0, 3] = n[3, 0] = s01 - s10
+    n[1, 2] = n[2, 1] = s01 + s10
+    n[1, 3] = n[3, 1] = s20 + s02
+    n[2, 3] = n[3, 2] = s12 + s21
     w, p, q, z = _largest_eigenvector(n)
     rotation = np.empty((3, 3))
     rotation[0, 0], rotation[1, 1] = w * w + p * p - q * q - z * z, w * w - p * p + q * q - z * z
@@ -78,14 +72,15 @@ def kabsch(x: np.ndarray, y: np.ndarray, rows: np.ndarray, count: int) -> tuple[
     rotation[0, 2], rotation[2, 0] = 2.0 * (p * z + w * q), 2.0 * (p * z - w * q)
     rotation[1, 2], rotation[2, 1] = 2.0 * (q * z - w * p), 2.0 * (q * z + w * p)
     translation = np.empty(3)
-    for c in range(3):
-        translation[c] = (cy0, cy1, cy2)[c] - rotation[c, 0] * cx0 - rotation[c, 1] * cx1 - rotation[c, 2] * cx2
+    translation[0] = cy0 - rotation[0, 0] * cx0 - rotation[0, 1] * cx1 - rotation[0, 2] * cx2
+    translation[1] = cy1 - rotation[1, 0] * cx0 - rotation[1, 1] * cx1 - rotation[1, 2] * cx2
+    translation[2] = cy2 - rotation[2, 0] * cx0 - rotation[2, 1] * cx1 - rotation[2, 2] * cx2
     return rotation, translation
 
 
 @njit(cache=True)
 def _largest_eigenvector(a: np.ndarray) -> tuple[float, float, float, float]:
-    """The unit eigenvector of the largest eigenvalue of the traceless symmetric 4 × 4 ``a``:
+    """The unit eigenvector of the largest eigenvalue of the traceless symmetric 4 × 4 ``a`` (kept):
     the eigenvalue by Newton's method on the characteristic polynomial from above (Theobald's
     QCP), the vector as the largest column of the adjugate of ``a - λ I``; by cyclic Jacobi
     rotations where that eigenvalue is (nearly) repeated."""
@@ -115,22 +110,22 @@ def _largest_eigenvector(a: np.ndarray) -> tuple[float, float, float, float]:
         value -= change
         if abs(change) <= 1e-14 * bound:
             break
-    m = a.copy()
     for i in range(4):
-        m[i, i] -= value
-    best, best_norm = np.zeros(4), 0.0
-    for j in range(4):  # column j of the adjugate: the cofactors of row j
-        column = np.empty(4)
+        a[i, i] -= value
+    best, best_norm = 0, 0.0
+    for j in range(4):  # column j of the adjugate of a - λ I: the cofactors of row j
         norm = 0.0
         for i in range(4):
-            column[i] = _cofactor(m, j, i)
-            norm += column[i] * column[i]
+            norm += _cofactor(a, j, i) ** 2
         if norm > best_norm:
-            best, best_norm = column, norm
+            best, best_norm = j, norm
+    w, p, q, z = _cofactor(a, best, 0), _cofactor(a, best, 1), _cofactor(a, best, 2), _cofactor(a, best, 3)
+    for i in range(4):
+        a[i, i] += value
     if best_norm <= (1e-8 * bound) ** 6:
         return _jacobi_largest(a)
-    best /= np.sqrt(best_norm)
-    return best[0], best[1], best[2], best[3]
+    scale = 1.0 / np.sqrt(best_norm)
+    return w * scale, p * scale, q * scale, z * scale
 
 
 _OTHERS = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
@@ -208,7 +203,7 @@ def _score_within(x: np.ndarray, y: np.ndarray, rotation: np.ndarray, translatio
                   cut: float, lnorm: float, chosen: np.ndarray) -> tuple[float, int]:
     """TM-align's ``score_fun8``: the TM-score (by ``lnorm``) of the pairs x[k] moved, y[k]
     closer than ``cut``, and the pairs closer than ``d`` (in ``chosen``; d grows by 0.5 Å
-    until there are 3)."""
+    until there are 3; all of them for 3 pairs)."""
     n = len(x)
     distance = np.empty(n)
     r, t = rotation, translation
@@ -229,11 +224,13 @@ def _score_within(x: np.ndarray, y: np.ndarray, rotation: np.ndarray, translatio
             if distance[k] < limit:
                 chosen[found] = k
                 found += 1
-        if found < 3 and n > 3:
-            grow += 1
-            limit = (d + grow * 0.5) ** 2
-        else:
+        if found >= 3 or n < 3:
             return score / lnorm, found
+        if n == 3:  # all three (TM-align would fit none)
+            chosen[:3] = np.arange(3)
+            return score / lnorm, 3
+        grow += 1
+        limit = (d + grow * 0.5) ** 2
 
 
 @njit(cache=True)
@@ -353,24 +350,54 @@ def pairing(score: np.ndarray, gap_open: float, invmap: np.ndarray) -> None:
     its columns of highest sum, less ``gap_open`` (<= 0, added) where a gap follows a pair;
     written to ``invmap`` (m,): the row paired with each column, -1 for none."""
     n, m = score.shape
-    step = np.empty((n, m), dtype=np.uint8)  # 0: the pair (i, j); 1: from (i, j - 1); 2: from (i - 1, j)
-    above, row = np.zeros(m + 1), np.zeros(m + 1)
-    gap_above, gap_row = np.zeros(m + 1), np.zeros(m + 1)  # gap_open where the cell is a pair, else 0
+    value, gap, step = np.zeros((2, m + 1)), np.zeros((2, m + 1)), np.empty((n, m), dtype=np.uint8)
     for i in range(n):
-        left, gap_left = 0.0, 0.0
-        for j in range(1, m + 1):
-            d = above[j - 1] + score[i, j - 1]
-            h = above[j] + gap_above[j]
-            v = left + gap_left
-            pair, down = d >= h and d >= v, v >= h
-            left = d if pair else v if down else h
-            gap_left = gap_open if pair else 0.0
-            step[i, j - 1] = 0 if pair else 1 if down else 2
-            row[j], gap_row[j] = left, gap_left
-        above, row = row, above
-        gap_above, gap_row = gap_row, gap_above
+        _pairing_row(score[i], gap_open, i, value, gap, step)
+    _trace(step, invmap)
+
+
+@njit(cache=True)
+def _superposed_pairing(x: np.ndarray, y: np.ndarray, rotation: np.ndarray, translation: np.ndarray, d0: float,
+                        gap_open: float, invmap: np.ndarray) -> None:
+    """:func:`pairing` of the TM-score terms ``1 / (1 + (d / d0)²)`` of x[i] moved and y[j],
+    computed a row at a time."""
+    moved = np.empty((len(x), 3))
+    _moved(x, rotation, translation, moved)
+    value, gap, step = np.zeros((2, len(y) + 1)), np.zeros((2, len(y) + 1)), np.empty((len(x), len(y)), dtype=np.uint8)
+    terms = np.empty(len(y))
+    d02 = d0 * d0
+    for i in range(len(x)):
+        for j in range(len(y)):
+            terms[j] = 1.0 / (1.0 + _squared(moved, y, i, j) / d02)
+        _pairing_row(terms, gap_open, i, value, gap, step)
+    _trace(step, invmap)
+
+
+@njit(cache=True)
+def _pairing_row(score: np.ndarray, gap_open: float, i: int, value: np.ndarray, gap: np.ndarray, step: np.ndarray
+                 ) -> None:
+    """Row i of TM-align's recursion from the scores of its cells: ``value`` (2, m + 1), the best
+    sums of rows i - 1 and i by parity; ``gap`` (2, m + 1), the gap opening after each of those
+    cells where it is a pair (else 0); ``step`` (n, m), the step into each cell (0: the pair
+    (i, j); 1: from (i, j - 1); 2: from (i - 1, j))."""
+    above, row, gap_above, gap_row = value[1 - i % 2], value[i % 2], gap[1 - i % 2], gap[i % 2]
+    left, gap_left = 0.0, 0.0
+    for j in range(1, len(score) + 1):
+        d = above[j - 1] + score[j - 1]
+        h = above[j] + gap_above[j]
+        v = left + gap_left
+        pair, down = d >= h and d >= v, v >= h
+        left = d if pair else v if down else h
+        gap_left = gap_open if pair else 0.0
+        step[i, j - 1] = 0 if pair else 1 if down else 2
+        row[j], gap_row[j] = left, gap_left
+
+
+@njit(cache=True)
+def _trace(step: np.ndarray, invmap: np.ndarray) -> None:
+    """The pairing of the dynamic programme, followed back from its last cell."""
     invmap[:] = -1
-    i, j = n - 1, m - 1
+    i, j = step.shape[0] - 1, step.shape[1] - 1
     while i >= 0 and j >= 0:
         if step[i, j] == 0:
             invmap[j] = i
@@ -407,7 +434,6 @@ def _dp_iterations(x: np.ndarray, y: np.ndarray, rotation: np.ndarray, translati
     repeats the rounds since then: the pass stops there, and the next starts from the
     superposition TM-align would reach after all ``rounds``.
     """
-    score = np.empty((len(x), len(y)))
     invmap = np.empty(len(y), dtype=np.int64)
     seen = np.empty((rounds, len(y)), dtype=np.int64)
     rotations, translations = np.empty((rounds, 3, 3)), np.empty((rounds, 3))
@@ -415,8 +441,7 @@ def _dp_iterations(x: np.ndarray, y: np.ndarray, rotation: np.ndarray, translati
     for g in range(first_gap, len(gaps)):
         old = 0.0
         for iteration in range(rounds):
-            _terms(x, y, rotation, translation, d0, score)
-            pairing(score, gaps[g], invmap)
+            _superposed_pairing(x, y, rotation, translation, d0, gaps[g], invmap)
             cycle = -1
             for earlier in range(iteration):
                 if np.all(seen[earlier] == invmap):
@@ -474,10 +499,12 @@ def _quick_score(x: np.ndarray, y: np.ndarray, invmap: np.ndarray, d0: float, d0
                 if distance[k] <= limit:
                     rows[count] = k
                     count += 1
-            if count < 3 and n > 3:
-                limit += 0.5
-            else:
+            if count >= 3 or n < 3:
                 break
+            if n == 3:  # all three (TM-align would fit none)
+                rows[:3], count = np.arange(3), 3
+                break
+            limit += 0.5
         if count == n and extra == 0.0:
             return best, best_rotation, best_translation
         rotation, translation = kabsch(px, py, rows, count)
@@ -514,7 +541,8 @@ def _local_superpositions(x: np.ndarray, y: np.ndarray, d0: float, d0_search: fl
     45 residues along each chain); the best by quick TM-score goes to ``invmap``.
 
     From :data:`COARSE_FROM` residues on, every superposition is first judged so on every
-    other residue of each chain (a quarter of the work), and the best :data:`LOCAL_KEEP` on all.
+    other residue of each chain (a quarter of the work; every third from twice as many), and
+    the best :data:`LOCAL_KEEP` on all.
     """
     xlen, ylen = len(x), len(y)
     d01 = d0 + 1.5
@@ -529,9 +557,8 @@ def _local_superpositions(x: np.ndarray, y: np.ndarray, d0: float, d0_search: fl
         total += ((xlen - size) // jumps[0] + 1) * ((ylen - size) // jumps[1] + 1)
     rotations, translations, screened = np.empty((total, 3, 3)), np.empty((total, 3)), np.full(total, -1.0)
     coarse = shorter >= COARSE_FROM
-    step = 2 if coarse else 1
+    step = 1 if not coarse else 2 if shorter < 2 * COARSE_FROM else 3
     cx, cy = np.ascontiguousarray(x[::step]), np.ascontiguousarray(y[::step])
-    score = np.empty((len(cx), len(cy)))
     trial = np.empty(len(cy), dtype=np.int64)
     rows = np.arange(max(xlen, ylen))
     k = 0
@@ -540,20 +567,18 @@ def _local_superpositions(x: np.ndarray, y: np.ndarray, d0: float, d0_search: fl
             for j in range(0, ylen - size + 1, jumps[1]):
                 if size >= 3:
                     rotations[k], translations[k] = kabsch(x[i:i + size], y[j:j + size], rows, size)
-                    _terms(cx, cy, rotations[k], translations[k], d01, score)
-                    pairing(score, 0.0, trial)
+                    _superposed_pairing(cx, cy, rotations[k], translations[k], d01, 0.0, trial)
                     screened[k] = _quick_score(cx, cy, trial, d0, d0_search)[0]
                 k += 1
     chosen = np.argsort(-screened)[:LOCAL_KEEP] if coarse else np.arange(total)
     if coarse:
-        score, trial = np.empty((xlen, ylen)), np.empty(ylen, dtype=np.int64)
+        trial = np.empty(ylen, dtype=np.int64)
     best, found = 0.0, False
     for k in chosen:
         if screened[k] < 0.0:
             continue
         if coarse:
-            _terms(x, y, rotations[k], translations[k], d01, score)
-            pairing(score, 0.0, trial)
+            _superposed_pairing(x, y, rotations[k], translations[k], d01, 0.0, trial)
             tm = _quick_score(x, y, trial, d0, d0_search)[0]
         else:
             tm = screened[k]
@@ -562,8 +587,7 @@ def _local_superpositions(x: np.ndarray, y: np.ndarray, d0: float, d0_search: fl
             if coarse:
                 invmap[:] = trial
             else:
-                _terms(x, y, rotations[k], translations[k], d01, score)
-                pairing(score, 0.0, invmap)
+                _superposed_pairing(x, y, rotations[k], translations[k], d01, 0.0, invmap)
     return found
 
 
