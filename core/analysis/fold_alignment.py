@@ -116,7 +116,7 @@ def align_folds(
             raise ValueError(f"the start needs at least {MIN_PAIRS} pairs of equal length; got {len(pairs_a)} "
                              f"and {len(pairs_b)}")
         given[pairs_b] = pairs_a
-    invmap, _, rotation, translation = tm_align.align(ca_a, ca_b, _ca_states(ca_a), _ca_states(ca_b), given)
+    invmap, _, rotation, translation = tm_align.align(ca_a, ca_b, given)
     pairs_b = np.flatnonzero(invmap >= 0)
     pairs_a = invmap[pairs_b]
     close = np.linalg.norm(ca_a[pairs_a] @ rotation.T + translation - ca_b[pairs_b], axis=1) <= tm_d8(
@@ -155,21 +155,3 @@ def monotone_pairs(score: np.ndarray, gap: float) -> tuple[np.ndarray, np.ndarra
     tm_align.pairing(score, -float(gap), invmap)
     columns = np.flatnonzero(invmap >= 0)
     return invmap[columns], columns
-
-
-def _ca_states(ca: np.ndarray) -> np.ndarray:
-    """(n,) int8 secondary structure of each residue from the distances of the Cα one to
-    four apart around it, as TM-align assigns it: 1 helix, 2 strand, 3 turn, 0 coil (and
-    the two residues at each end)."""
-    n = len(ca)
-    states = np.zeros(n, dtype=np.int8)
-    if n < 5:
-        return states
-    d2, d3, d4 = (np.linalg.norm(ca[k:] - ca[:-k], axis=1) for k in (2, 3, 4))
-    d13, d24, d35, d14, d25, d15 = d2[:-2], d2[1:-1], d2[2:], d3[:-1], d3[1:], d4  # residues c-2 .. c+2 are 1 .. 5
-    helix = np.all([np.abs(d - ref) < 2.1 for d, ref in ((d13, 5.45), (d24, 5.45), (d35, 5.45), (d14, 5.18),
-                                                          (d25, 5.18), (d15, 6.37))], axis=0)
-    strand = np.all([np.abs(d - ref) < 1.42 for d, ref in ((d13, 6.1), (d24, 6.1), (d35, 6.1), (d14, 10.4),
-                                                           (d25, 10.4), (d15, 13.0))], axis=0)
-    states[2:-2] = np.select([helix, strand, d15 < 8.0], [1, 2, 3], 0)
-    return states

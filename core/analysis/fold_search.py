@@ -40,6 +40,7 @@ from scipy.spatial.distance import pdist
 from core.analysis.compare import FoldMatch, fold_match
 from core.analysis.database import SkippedFile
 from core.analysis.fold_alignment import align_folds
+from core.analysis.tm_align import screen
 from core.curves.wavelets import smooth
 from core.protein.reading import read_structure
 from core.protein.structure import Structure
@@ -208,8 +209,9 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candi
     ``candidates`` nearest to the query's descriptor, best first.
 
     The candidates are screened by the TM-score of the alignment of every
-    :data:`SCREEN_STEP`-th Cα of each chain (a small fraction of a full alignment's work),
-    and the best ``aligned`` of them (at least ``top``) aligned in full.
+    :data:`SCREEN_STEP`-th Cα of each chain (:func:`core.analysis.tm_align.screen`, a small
+    fraction of a full alignment's work), and the best ``aligned`` of them (at least ``top``)
+    aligned in full.
 
     Parameters
     ----------
@@ -217,12 +219,10 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candi
     """
     ca = np.asarray(ca, dtype=np.float64)
     distance = descriptor_distances(index.descriptors, curve_descriptor(ca))
-    nearest = np.argsort(distance, kind="stable")[:max(candidates, aligned, top)].tolist()
-    coarse = ca[::SCREEN_STEP]
-    screened = [align_folds(coarse, index.chain(row)[0][::SCREEN_STEP]).tm_score
-                if len(coarse) >= MIN_RESIDUES // SCREEN_STEP and index.lengths[row] >= MIN_RESIDUES else 0.0
-                for row in nearest]
-    chosen = [nearest[k] for k in np.argsort(screened, kind="stable")[::-1][:max(aligned, top)]]
+    nearest = np.argsort(distance, kind="stable")[:max(candidates, aligned, top)]
+    starts = np.concatenate([[0], np.cumsum(index.lengths)[:-1]]).astype(np.int64)
+    screened = screen(ca, index.coordinates, starts, index.lengths.astype(np.int64), nearest, SCREEN_STEP)
+    chosen = nearest[np.argsort(-screened, kind="stable")[:max(aligned, top)]].tolist()
     alignments = {row: align_folds(ca, index.chain(row)[0]) for row in chosen}
     best = sorted(chosen, key=lambda row: -alignments[row].tm_score)[:top]
     names = np.frombuffer(sequence.encode("ascii", "replace"), dtype="S1")

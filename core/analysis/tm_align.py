@@ -42,19 +42,18 @@ def kabsch(x: np.ndarray, y: np.ndarray, rows: np.ndarray, count: int) -> tuple[
     unit quaternion, the eigenvector of the largest eigenvalue of a symmetric 4 × 4 matrix
     (:func:`_largest_eigenvector`)."""
     cx0 = cx1 = cx2 = cy0 = cy1 = cy2 = 0.0
-    for k in range(count):
-        r = rows[k]
-        cx0, cx1, cx2 = cx0 + x[r, 0], cx1 + x[r, 1], cx2 + x[r, 2]
-        cy0, cy1, cy2 = cy0 + y[r, 0], cy1 + y[r, 1], cy2 + y[r, 2]
-    cx0, cx1, cx2, cy0, cy1, cy2 = cx0 / count, cx1 / count, cx2 / count, cy0 / count, cy1 / count, cy2 / count
     s00 = s01 = s02 = s10 = s11 = s12 = s20 = s21 = s22 = 0.0
-    for k in range(count):
+    for k in range(count):  # one pass: sums, then the centred sums of products from them
         r = rows[k]
-        a0, a1, a2 = x[r, 0] - cx0, x[r, 1] - cx1, x[r, 2] - cx2
-        b0, b1, b2 = y[r, 0] - cy0, y[r, 1] - cy1, y[r, 2] - cy2
+        a0, a1, a2, b0, b1, b2 = x[r, 0], x[r, 1], x[r, 2], y[r, 0], y[r, 1], y[r, 2]
+        cx0, cx1, cx2, cy0, cy1, cy2 = cx0 + a0, cx1 + a1, cx2 + a2, cy0 + b0, cy1 + b1, cy2 + b2
         s00, s01, s02 = s00 + a0 * b0, s01 + a0 * b1, s02 + a0 * b2
         s10, s11, s12 = s10 + a1 * b0, s11 + a1 * b1, s12 + a1 * b2
         s20, s21, s22 = s20 + a2 * b0, s21 + a2 * b1, s22 + a2 * b2
+    cx0, cx1, cx2, cy0, cy1, cy2 = cx0 / count, cx1 / count, cx2 / count, cy0 / count, cy1 / count, cy2 / count
+    s00, s01, s02 = s00 - count * cx0 * cy0, s01 - count * cx0 * cy1, s02 - count * cx0 * cy2
+    s10, s11, s12 = s10 - count * cx1 * cy0, s11 - count * cx1 * cy1, s12 - count * cx1 * cy2
+    s20, s21, s22 = s20 - count * cx2 * cy0, s21 - count * cx2 * cy1, s22 - count * cx2 * cy2
     n = np.empty((4, 4))
     n[0, 0], n[1, 1] = s00 + s11 + s22, s00 - s11 - s22
     n[2, 2], n[3, 3] = -s00 + s11 - s22, -s00 - s11 + s22
@@ -365,12 +364,19 @@ def _superposed_pairing(x: np.ndarray, y: np.ndarray, rotation: np.ndarray, tran
     _moved(x, rotation, translation, moved)
     value, gap, step = np.zeros((2, len(y) + 1)), np.zeros((2, len(y) + 1)), np.empty((len(x), len(y)), dtype=np.uint8)
     terms = np.empty(len(y))
-    d02 = d0 * d0
     for i in range(len(x)):
-        for j in range(len(y)):
-            terms[j] = 1.0 / (1.0 + _squared(moved, y, i, j) / d02)
+        _row_terms(moved[i], y, d0, terms)
         _pairing_row(terms, gap_open, i, value, gap, step)
     _trace(step, invmap)
+
+
+@njit(cache=True, fastmath=True)
+def _row_terms(point: np.ndarray, y: np.ndarray, d0: float, terms: np.ndarray) -> None:
+    """``terms[j]``: the TM-score term ``1 / (1 + (d / d0)²)`` of ``point`` and y[j]."""
+    scale = 1.0 / (d0 * d0)
+    for j in range(len(y)):
+        d = (point[0] - y[j, 0]) ** 2 + (point[1] - y[j, 1]) ** 2 + (point[2] - y[j, 2]) ** 2
+        terms[j] = 1.0 / (1.0 + d * scale)
 
 
 @njit(cache=True)
@@ -686,17 +692,16 @@ def _states_pairing(states_x: np.ndarray, states_y: np.ndarray, invmap: np.ndarr
 
 
 @njit(cache=True)
-def align(x: np.ndarray, y: np.ndarray, states_x: np.ndarray, states_y: np.ndarray, given: np.ndarray
-          ) -> tuple[np.ndarray, float, np.ndarray, np.ndarray]:
-    """TM-align's search for the alignment of chains x (n, 3) and y (m, 3), both 5 residues
-    or more, with their secondary-structure states (n,) and (m,), and ``given``, a pairing
-    (m,) to start from as well (all -1: none).
+def align(x: np.ndarray, y: np.ndarray, given: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, np.ndarray]:
+    """TM-align's search for the alignment of chains x (n, 3) and y (m, 3), 3 residues or more
+    each, with ``given``, a pairing (m,) to start from as well (all -1: none).
 
     Returns the best pairing (``invmap``, m), its TM-score in the search (by the shorter
     chain, with TM-align's search d0) and the superposition of x on y that TM-score's search
     finds for it with every fragment as a start (rotation, translation).
     """
     xlen, ylen = len(x), len(y)
+    states_x, states_y = secondary_states(x), secondary_states(y)
     shorter = min(xlen, ylen)
     d0 = (0.168 if shorter <= 19 else 1.24 * (shorter - 15.0) ** (1.0 / 3.0) - 1.8) + 0.8
     d0_search = min(max(d0, 4.5), 8.0)
@@ -735,3 +740,58 @@ def align(x: np.ndarray, y: np.ndarray, states_x: np.ndarray, states_y: np.ndarr
                 best_map[:] = found
     _, rotation, translation = _detailed_search(x, y, best_map, 1, d0, d0_search, cut, shorter)
     return best_map, best, rotation, translation
+
+
+@njit(cache=True)
+def screen(query: np.ndarray, coordinates: np.ndarray, starts: np.ndarray, lengths: np.ndarray, rows: np.ndarray,
+           step: int) -> np.ndarray:
+    """Quick TM-scores (normalised by the query) of the query's Cα (n, 3) against the chains
+    ``rows`` of ``coordinates`` (the chain k: ``lengths[k]`` rows from ``starts[k]``), each
+    chain taken at every ``step``-th Cα: :func:`align`, then the TM-score search (from fragments
+    :data:`SIMPLIFY_STEP` pairs apart) of its pairs within TM-align's cutoff. 0 for a chain of
+    fewer than 5 Cα so taken."""
+    x = np.ascontiguousarray(query[::step])
+    scores = np.zeros(len(rows))
+    if len(x) < 5:
+        return scores
+    d0 = max(1.24 * max(len(x) - 15.0, 0.0) ** (1.0 / 3.0) - 1.8, 0.5)
+    for k in range(len(rows)):
+        first = starts[rows[k]]
+        y = coordinates[first:first + lengths[rows[k]]:step].astype(np.float64)
+        if len(y) < 5:
+            continue
+        invmap, _, rotation, translation = align(x, y, np.full(len(y), -1, dtype=np.int64))
+        cut = 1.5 * min(len(x), len(y)) ** 0.3 + 3.5
+        close = np.full(len(y), -1, dtype=np.int64)
+        moved = np.empty((len(x), 3))
+        _moved(x, rotation, translation, moved)
+        for j in range(len(y)):
+            if invmap[j] >= 0 and _squared(moved, y, invmap[j], j) <= cut * cut:
+                close[j] = invmap[j]
+        if np.sum(close >= 0) < 3:
+            close = invmap
+        scores[k] = _detailed_search(x, y, close, SIMPLIFY_STEP, d0, min(max(d0, 4.5), 8.0), np.inf, len(x))[0]
+    return scores
+
+
+@njit(cache=True)
+def secondary_states(ca: np.ndarray) -> np.ndarray:
+    """(n,) int8 secondary structure of each residue from the distances of the Cα one to
+    four apart around it, as TM-align assigns it: 1 helix, 2 strand, 3 turn, 0 coil (and
+    the two residues at each end)."""
+    n = len(ca)
+    states = np.zeros(n, dtype=np.int8)
+    for c in range(2, n - 2):
+        d13, d24, d35 = (np.sqrt(_squared(ca, ca, c - 2, c)), np.sqrt(_squared(ca, ca, c - 1, c + 1)),
+                         np.sqrt(_squared(ca, ca, c, c + 2)))
+        d14, d25 = np.sqrt(_squared(ca, ca, c - 2, c + 1)), np.sqrt(_squared(ca, ca, c - 1, c + 2))
+        d15 = np.sqrt(_squared(ca, ca, c - 2, c + 2))
+        if (abs(d15 - 6.37) < 2.1 and abs(d14 - 5.18) < 2.1 and abs(d25 - 5.18) < 2.1 and abs(d13 - 5.45) < 2.1
+                and abs(d24 - 5.45) < 2.1 and abs(d35 - 5.45) < 2.1):
+            states[c] = 1
+        elif (abs(d15 - 13.0) < 1.42 and abs(d14 - 10.4) < 1.42 and abs(d25 - 10.4) < 1.42 and abs(d13 - 6.1) < 1.42
+              and abs(d24 - 6.1) < 1.42 and abs(d35 - 6.1) < 1.42):
+            states[c] = 2
+        elif d15 < 8.0:
+            states[c] = 3
+    return states
