@@ -199,12 +199,11 @@ def _squared(a: np.ndarray, b: np.ndarray, i: int, j: int) -> float:
 
 @njit(cache=True, fastmath=True)
 def _score_within(x: np.ndarray, y: np.ndarray, rotation: np.ndarray, translation: np.ndarray, d: float, d0: float,
-                  cut: float, lnorm: float, chosen: np.ndarray) -> tuple[float, int]:
+                  cut: float, lnorm: float, chosen: np.ndarray, distance: np.ndarray) -> tuple[float, int]:
     """TM-align's ``score_fun8``: the TM-score (by ``lnorm``) of the pairs x[k] moved, y[k]
     closer than ``cut``, and the pairs closer than ``d`` (in ``chosen``; d grows by 0.5 Å
-    until there are 3; all of them for 3 pairs)."""
+    until there are 3; all of them for 3 pairs); ``distance`` (n,): room for the squared distances."""
     n = len(x)
-    distance = np.empty(n)
     r, t = rotation, translation
     for k in range(n):
         a = r[0, 0] * x[k, 0] + r[0, 1] * x[k, 1] + r[0, 2] * x[k, 2] + t[0] - y[k, 0]
@@ -245,6 +244,7 @@ def tm_search(x: np.ndarray, y: np.ndarray, step: int, d0: float, d0_search: flo
     """
     n = len(x)
     rows, chosen, settled = np.arange(n), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    distance = np.empty(n)
     best, best_rotation, best_translation = -1.0, np.eye(3), np.zeros(3)
     best_rows, best_count = np.arange(n), n
     smallest = min(4, n)
@@ -257,7 +257,8 @@ def tm_search(x: np.ndarray, y: np.ndarray, step: int, d0: float, d0_search: flo
         first = 0
         while True:
             rotation, translation = kabsch(x, y, rows[first:], size)
-            score, count = _score_within(x, y, rotation, translation, d0_search - 1.0, d0, cut, lnorm, chosen)
+            score, count = _score_within(x, y, rotation, translation, d0_search - 1.0, d0, cut, lnorm, chosen,
+                                         distance)
             if score > best:
                 best, best_rotation, best_translation = score, rotation, translation
                 best_rows[:size], best_count = rows[first:first + size], size
@@ -267,11 +268,12 @@ def tm_search(x: np.ndarray, y: np.ndarray, step: int, d0: float, d0_search: flo
                 settled[:count] = chosen[:count]
                 fitted = count
                 rotation, translation = kabsch(x, y, settled, fitted)
-                score, count = _score_within(x, y, rotation, translation, d0_search + 1.0, d0, cut, lnorm, chosen)
+                score, count = _score_within(x, y, rotation, translation, d0_search + 1.0, d0, cut, lnorm,
+                                             chosen, distance)
                 if score > best:
                     best, best_rotation, best_translation = score, rotation, translation
                     best_rows[:fitted], best_count = settled[:fitted], fitted
-                if count == fitted and np.all(chosen[:count] == settled[:count]):
+                if count == fitted and _same(chosen, settled, count):
                     break
             if first >= last:
                 break
@@ -279,6 +281,15 @@ def tm_search(x: np.ndarray, y: np.ndarray, step: int, d0: float, d0_search: flo
     used = np.zeros(n, dtype=np.bool_)
     used[best_rows[:best_count]] = True
     return best, best_rotation, best_translation, used
+
+
+@njit(cache=True)
+def _same(a: np.ndarray, b: np.ndarray, count: int) -> bool:
+    """Whether the first ``count`` entries of ``a`` and ``b`` agree."""
+    for k in range(count):
+        if a[k] != b[k]:
+            return False
+    return True
 
 
 @njit(cache=True)
