@@ -30,8 +30,10 @@ back without pickle).
 from __future__ import annotations
 
 import io
+import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -59,8 +61,8 @@ RANK_BLOCK = 8192
 """Index rows ranked at once."""
 MIN_RESIDUES = 20
 """Chains with fewer residues are not indexed (peptides have no fold to search)."""
-FORMAT = 1
-"""Version of the index file."""
+FORMAT = 2
+"""Version of the index file (2: uncompressed, the coordinates and sequences mapped)."""
 SCREEN_STEP = 4
 """The candidates of :func:`search` are screened by aligning every 4th Cα of each chain."""
 FIELDS = ("format", "entries", "chains", "paths", "lengths", "descriptors", "coordinates", "sequences")
@@ -117,28 +119,39 @@ class FoldIndex:
     def __len__(self) -> int:
         return len(self.entries)
 
+    @cached_property
+    def starts(self) -> np.ndarray:
+        """(n,) int64: the first row of each chain in ``coordinates`` and ``sequences``."""
+        return np.concatenate([[0], np.cumsum(self.lengths)[:-1]]).astype(np.int64)
+
     def chain(self, k: int) -> tuple[np.ndarray, np.ndarray]:
         """The Cα (float64) and one-letter codes of chain ``k``."""
-        first = int(self.lengths[:k].sum())
-        rows = slice(first, first + int(self.lengths[k]))
-        return self.coordinates[rows].astype(np.float64), self.sequences[rows]
+        rows = slice(int(self.starts[k]), int(self.starts[k] + self.lengths[k]))
+        return np.asarray(self.coordinates[rows], dtype=np.float64), np.asarray(self.sequences[rows])
 
     def to_bytes(self) -> bytes:
-        """The index as an ``.npz`` archive (plain arrays, no pickled objects)."""
+        """The index as an uncompressed ``.npz`` archive of plain arrays (no pickled objects), so
+        that :meth:`read` maps the coordinates and sequences instead of reading them."""
         out = io.BytesIO()
-        np.savez_compressed(out, format=np.array(FORMAT), **{name: getattr(self, name) for name in FIELDS[1:]})
+        np.savez(out, format=np.array(FORMAT), **{name: getattr(self, name) for name in FIELDS[1:]})
         return out.getvalue()
 
     @classmethod
     def read(cls, path: Path) -> FoldIndex:
-        """Read an index written by :meth:`to_bytes`; ValueError when it is not one."""
+        """Read an index written by :meth:`to_bytes`, its coordinates and sequences mapped from
+        the file (read as the chains are used); ValueError when it is not one."""
         try:
             with np.load(path, allow_pickle=False) as archive:
-                arrays = {name: archive[name] for name in FIELDS}
-        except (OSError, ValueError, KeyError, EOFError) as error:
+                if int(archive["format"]) != FORMAT:
+                    raise ValueError(f"{path}: a fold index of another format version (index the files again)")
+                arrays = {name: archive[name] for name in FIELDS[1:6]}
+            arrays |= {name: _mapped(path, name) for name in FIELDS[6:]}
+        except (OSError, KeyError, EOFError, zipfile.BadZipFile) as error:
             raise ValueError(f"{path}: not a ribbonwave fold index ({type(error).__name__}: {error})") from None
-        if int(arrays.pop("format")) != FORMAT:
-            raise ValueError(f"{path}: a fold index of another format version")
+        except ValueError as error:
+            if "format version" in str(error):
+                raise
+            raise ValueError(f"{path}: not a ribbonwave fold index ({type(error).__name__}: {error})") from None
         index = cls(**arrays)
         n = len(index.entries)
         residues = int(index.lengths.sum())
@@ -146,6 +159,28 @@ class FoldIndex:
                 or len(index.coordinates) != residues or len(index.sequences) != residues):
             raise ValueError(f"{path}: a damaged fold index (its arrays disagree)")
         return index
+
+
+def _mapped(path: Path, name: str) -> np.ndarray:
+    """The array ``name`` of an uncompressed ``.npz`` archive, mapped read-only from the file."""
+    with zipfile.ZipFile(path) as archive:
+        info = archive.getinfo(f"{name}.npy")
+    if info.compress_type != zipfile.ZIP_STORED:
+        raise ValueError(f"{name} is compressed")
+    with open(path, "rb") as file:
+        file.seek(info.header_offset)
+        header = file.read(30)  # the zip entry's local header, then its name and extra field
+        file.seek(info.header_offset + 30 + int.from_bytes(header[26:28], "little")
+                  + int.from_bytes(header[28:30], "little"))
+        version = np.lib.format.read_magic(file)
+        shape, fortran, dtype = (np.lib.format.read_array_header_1_0(file) if version == (1, 0)
+                                 else np.lib.format.read_array_header_2_0(file))
+        offset = file.tell()
+    if dtype.hasobject or fortran:
+        raise ValueError(f"{name} is not a plain array")
+    if not np.prod(shape):
+        return np.zeros(shape, dtype=dtype)
+    return np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape)
 
 
 def index_structure(structure: Structure, path: Path | str = "") -> FoldIndex:
@@ -220,8 +255,10 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candi
     ca = np.asarray(ca, dtype=np.float64)
     distance = descriptor_distances(index.descriptors, curve_descriptor(ca))
     nearest = np.argsort(distance, kind="stable")[:max(candidates, aligned, top)]
-    starts = np.concatenate([[0], np.cumsum(index.lengths)[:-1]]).astype(np.int64)
-    screened = screen(ca, index.coordinates, starts, index.lengths.astype(np.int64), nearest, SCREEN_STEP)
+    chains = [index.chain(row)[0] for row in nearest.tolist()]  # read from the file now
+    lengths = np.array([len(other) for other in chains], dtype=np.int64)
+    screened = screen(ca, np.concatenate(chains or [np.zeros((0, 3))]), np.concatenate([[0], np.cumsum(lengths)[:-1]]),
+                      lengths, SCREEN_STEP)
     chosen = nearest[np.argsort(-screened, kind="stable")[:max(aligned, top)]].tolist()
     alignments = {row: align_folds(ca, index.chain(row)[0]) for row in chosen}
     best = sorted(chosen, key=lambda row: -alignments[row].tm_score)[:top]

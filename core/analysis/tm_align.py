@@ -754,21 +754,20 @@ def align(x: np.ndarray, y: np.ndarray, given: np.ndarray) -> tuple[np.ndarray, 
 
 
 @njit(cache=True)
-def screen(query: np.ndarray, coordinates: np.ndarray, starts: np.ndarray, lengths: np.ndarray, rows: np.ndarray,
-           step: int) -> np.ndarray:
+def screen(query: np.ndarray, coordinates: np.ndarray, starts: np.ndarray, lengths: np.ndarray, step: int
+           ) -> np.ndarray:
     """Quick TM-scores (normalised by the query) of the query's Cα (n, 3) against the chains
-    ``rows`` of ``coordinates`` (the chain k: ``lengths[k]`` rows from ``starts[k]``), each
-    chain taken at every ``step``-th Cα: :func:`align`, then the TM-score search (from fragments
+    of ``coordinates`` (chain k: ``lengths[k]`` rows from ``starts[k]``), each chain taken at
+    every ``step``-th Cα: :func:`align`, then the TM-score search (from fragments
     :data:`SIMPLIFY_STEP` pairs apart) of its pairs within TM-align's cutoff. 0 for a chain of
     fewer than 5 Cα so taken."""
     x = np.ascontiguousarray(query[::step])
-    scores = np.zeros(len(rows))
+    scores = np.zeros(len(starts))
     if len(x) < 5:
         return scores
     d0 = max(1.24 * max(len(x) - 15.0, 0.0) ** (1.0 / 3.0) - 1.8, 0.5)
-    for k in range(len(rows)):
-        first = starts[rows[k]]
-        y = coordinates[first:first + lengths[rows[k]]:step].astype(np.float64)
+    for k in range(len(starts)):
+        y = np.ascontiguousarray(coordinates[starts[k]:starts[k] + lengths[k]:step])
         if len(y) < 5:
             continue
         invmap, _, rotation, translation = align(x, y, np.full(len(y), -1, dtype=np.int64))

@@ -63,6 +63,14 @@ def test_the_index_file_round_trip_and_refusals(index, tmp_path) -> None:
     again = FoldIndex.read(path)
     for name in ("entries", "chains", "lengths", "descriptors", "coordinates", "sequences"):
         assert np.array_equal(getattr(again, name), getattr(index, name))
+    assert isinstance(again.coordinates, np.memmap) and isinstance(again.sequences, np.memmap)  # read per chain
+    ca, codes = index.chain(3)
+    assert [(h.row, h.match.tm_score_a) for h in search(again, ca, codes.tobytes().decode(), top=3)] == [
+        (h.row, h.match.tm_score_a) for h in search(index, ca, codes.tobytes().decode(), top=3)]
+    arrays = dict(np.load(path))
+    np.savez_compressed(tmp_path / "old.npz", **(arrays | {"format": np.array(1)}))
+    with pytest.raises(ValueError, match="another format version"):
+        FoldIndex.read(tmp_path / "old.npz")
     pickled = tmp_path / "pickled.npz"
     np.savez(pickled, entries=np.array([{"not": "an array"}], dtype=object))
     with pytest.raises(ValueError, match="not a ribbonwave fold index"):
