@@ -116,7 +116,7 @@ def align_folds(
             raise ValueError(f"the start needs at least {MIN_PAIRS} pairs of equal length; got {len(pairs_a)} "
                              f"and {len(pairs_b)}")
         given[pairs_b] = pairs_a
-    invmap, _, rotation, translation = tm_align.align(ca_a, ca_b, given)
+    invmap, _, rotation, translation = tm_align.align(np.ascontiguousarray(ca_a), np.ascontiguousarray(ca_b), given)
     pairs_b = np.flatnonzero(invmap >= 0)
     pairs_a = invmap[pairs_b]
     close = np.linalg.norm(ca_a[pairs_a] @ rotation.T + translation - ca_b[pairs_b], axis=1) <= tm_d8(

@@ -17,14 +17,16 @@ need about 0.3 GB.
 A global descriptor of the whole chain knows nothing of domains: a fold found as one domain
 of a larger chain, or a chain whose termini differ in length, ranks lower than it would by
 TM-score, and mirror images have equal profiles (the alignment tells them apart). The
-ranking only chooses which chains to align: :func:`search` aligns the best
-``candidates`` of them with :func:`core.analysis.fold_alignment.align_folds` and orders the
+ranking only chooses which chains to align: :func:`search` screens the nearest
+``candidates`` by a quick alignment of every 4th Cα (:func:`core.analysis.tm_align.screen`),
+aligns the best of them with :func:`core.analysis.fold_alignment.align_folds` and orders the
 hits by TM-score, so the figures it prints are TM-align's, not the descriptor's.
 
 :func:`index_path` is the unit of parallel work (a top-level function of a path that never
 raises for a bad file); :class:`FoldIndex` holds the chains of many files, their
-descriptors, Cα and sequences, and is saved as an ``.npz`` archive of plain arrays (read
-back without pickle).
+descriptors, Cα and sequences, and is saved as an uncompressed ``.npz`` archive of plain
+arrays (read back without pickle; the Cα and sequences, 13 bytes a residue, mapped from the
+file, so a search reads only its candidates' rows).
 """
 
 from __future__ import annotations
