@@ -28,9 +28,11 @@ QUICK_DP_ROUNDS = 2
 """Rounds from the local superpositions and the fragment threading (TM-align's)."""
 GAP_OPEN = (-0.6, 0.0)
 """TM-align's two gap penalties of the rounds."""
-COARSE_FROM = 80
+COARSE_FROM = 40
 """Residues of the shorter chain from which the local superpositions are screened on every
-other residue (every third from twice as many; :func:`_local_superpositions`)."""
+other residue (:func:`_local_superpositions`)."""
+COARSER_FROM = 160
+"""Residues of the shorter chain from which they are screened on every third."""
 LOCAL_KEEP = 4
 """Local superpositions kept from that screen."""
 
@@ -558,8 +560,8 @@ def _local_superpositions(x: np.ndarray, y: np.ndarray, d0: float, d0_search: fl
     45 residues along each chain); the best by quick TM-score goes to ``invmap``.
 
     From :data:`COARSE_FROM` residues on, every superposition is first judged so on every
-    other residue of each chain (a quarter of the work; every third from twice as many), and
-    the best :data:`LOCAL_KEEP` on all.
+    other residue of each chain (a quarter of the work; every third from :data:`COARSER_FROM`),
+    and the best :data:`LOCAL_KEEP` on all.
     """
     xlen, ylen = len(x), len(y)
     d01 = d0 + 1.5
@@ -574,7 +576,7 @@ def _local_superpositions(x: np.ndarray, y: np.ndarray, d0: float, d0_search: fl
         total += ((xlen - size) // jumps[0] + 1) * ((ylen - size) // jumps[1] + 1)
     rotations, translations, screened = np.empty((total, 3, 3)), np.empty((total, 3)), np.full(total, -1.0)
     coarse = shorter >= COARSE_FROM
-    step = 1 if not coarse else 2 if shorter < 2 * COARSE_FROM else 3
+    step = 1 if not coarse else 2 if shorter < COARSER_FROM else 3
     cx, cy = np.ascontiguousarray(x[::step]), np.ascontiguousarray(y[::step])
     trial = np.empty(len(cy), dtype=np.int64)
     rows = np.arange(max(xlen, ylen))

@@ -1,5 +1,6 @@
 """Fold descriptors of the low-level curves: invariant to position and orientation, near for one
-fold and far for others; the index file round trip and what it refuses."""
+fold and far for others; the screen of the candidates against the full alignment; the index
+file round trip and what it refuses."""
 
 from pathlib import Path
 
@@ -7,6 +8,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from core.analysis.fold_alignment import align_folds
 from core.analysis.fold_search import (
     DESCRIPTOR_SIZE,
     FoldIndex,
@@ -16,6 +18,7 @@ from core.analysis.fold_search import (
     merge,
     search,
 )
+from core.analysis.tm_align import screen
 from core.curves.wavelets import smooth
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -55,6 +58,17 @@ def test_search_orders_the_candidates_by_tm_score(index) -> None:
     hits = search(index, ca, codes.tobytes().decode(), top=3, candidates=len(index), aligned=3)
     assert [h.entry for h in hits[:2]] == ["1BMA", "3PTB"] and hits[0].match.tm_score_a == pytest.approx(1.0)
     assert hits[0].match.tm_score_a >= hits[1].match.tm_score_a >= hits[2].match.tm_score_a
+
+
+def test_the_screen_scores_as_the_alignment_does(index) -> None:
+    """On every Cα, the screen's TM-score is the full alignment's (to its quicker final search);
+    on every 4th, trypsin and elastase still rank first for elastase, ubiquitin last."""
+    ca, _ = index.chain(int(np.flatnonzero(index.entries == "1BMA")[0]))
+    full = np.array([align_folds(ca, index.chain(k)[0]).tm_score for k in range(len(index))])
+    assert screen(ca, index.coordinates, index.starts, index.lengths, 1) == pytest.approx(full, abs=0.01)
+    quick = screen(ca, index.coordinates, index.starts, index.lengths, 4)
+    order = index.entries[np.argsort(-quick)].tolist()
+    assert order[:2] == ["1BMA", "3PTB"] and set(order[-2:]) == {"1UBQ", "2K39_CA-only"}
 
 
 def test_the_index_file_round_trip_and_refusals(index, tmp_path) -> None:
