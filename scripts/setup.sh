@@ -61,5 +61,17 @@ if [[ ! -e "$stamp" || "$root/pyproject.toml" -nt "$stamp" ]]; then
     echo "$log" >&2
     exit 1
   fi
+  # numba compiles the structural alignment's kernels on their first use (a minute or two on a
+  # busy machine) and caches them: done here, the first comparison or search does not wait.
+  echo "setup.sh: compiling the structural alignment" >&2
+  "$venv/bin/python" - <<'PY'
+import numpy as np
+from core.analysis.fold_alignment import align_folds
+from core.analysis.tm_align import screen
+turns = np.arange(40.0)
+helix = np.stack([2.3 * np.cos(1.75 * turns), 2.3 * np.sin(1.75 * turns), 1.5 * turns], axis=1)
+align_folds(helix, helix[::-1].copy())
+screen(helix, helix, np.array([0]), np.array([40]), 4)
+PY
   touch "$stamp"
 fi

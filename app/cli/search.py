@@ -89,9 +89,11 @@ def search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("index", type=Path, metavar="DB", help="an index written by 'ribbonwave index'")
     parser.add_argument("--top", type=bounded(int, 1, 10000), default=10, metavar="K",
                         help="hits to print (default %(default)s)")
-    parser.add_argument("--candidates", type=bounded(int, 1, 100000), default=20, metavar="C",
-                        help="chains nearest the query's descriptor that are aligned by structure "
+    parser.add_argument("--candidates", type=bounded(int, 1, 100000), default=60, metavar="C",
+                        help="chains nearest the query's descriptor that are screened by aligning every 4th Cα "
                         "(default %(default)s)")
+    parser.add_argument("--aligned", type=bounded(int, 1, 100000), default=15, metavar="A",
+                        help="of those, the best that are aligned in full (default %(default)s)")
     parser.add_argument("--json", action="store_true", help="print a JSON object instead of the table")
 
 
@@ -113,13 +115,14 @@ def run_search(args: argparse.Namespace) -> int:
         raise InputError(str(error)) from None
     start = time.perf_counter()
     ca = np.concatenate([s.ca for s in segments])
-    hits = search(index, ca, "".join(s.sequence for s in segments), args.top, args.candidates)
+    hits = search(index, ca, "".join(s.sequence for s in segments), args.top, args.candidates, args.aligned)
     seconds = time.perf_counter() - start
     report = {
         "query": f"{path} chain {chain}",
         "query_length": len(ca),
         "searched": len(index),
-        "aligned": min(max(args.candidates, args.top), len(index)),
+        "screened": min(max(args.candidates, args.aligned, args.top), len(index)),
+        "aligned": min(max(args.aligned, args.top), len(index)),
         "seconds": round(seconds, 3),
         "hits": [
             {"entry": h.entry, "chain": h.chain, "path": h.path, "length": h.length,
@@ -135,7 +138,8 @@ def run_search(args: argparse.Namespace) -> int:
 
 def _table(report: dict) -> str:
     lines = [f"{report['query']} ({report['query_length']} residues) against {report['searched']} chains: "
-             f"{report['aligned']} nearest by descriptor aligned in {report['seconds']:.2f} s",
+             f"{report['screened']} nearest by descriptor screened, {report['aligned']} aligned in "
+             f"{report['seconds']:.2f} s",
              "TM-score normalised by the query (and by the hit); below 0.5 the folds differ",
              f"{'rank':>4}  {'entry':<12} {'chain':<6}{'length':>7}{'TM-score':>10}{'(hit)':>8}{'aligned':>9}"
              f"{'rms Å':>8}{'identity':>10}{'descr. Å':>10}"]

@@ -17,21 +17,25 @@ need about 0.3 GB.
 A global descriptor of the whole chain knows nothing of domains: a fold found as one domain
 of a larger chain, or a chain whose termini differ in length, ranks lower than it would by
 TM-score, and mirror images have equal profiles (the alignment tells them apart). The
-ranking only chooses which chains to align: :func:`search` aligns the best
-``candidates`` of them with :func:`core.analysis.fold_alignment.align_folds` and orders the
+ranking only chooses which chains to align: :func:`search` screens the nearest
+``candidates`` by a quick alignment of every 4th Cα (:func:`core.analysis.tm_align.screen`),
+aligns the best of them with :func:`core.analysis.fold_alignment.align_folds` and orders the
 hits by TM-score, so the figures it prints are TM-align's, not the descriptor's.
 
 :func:`index_path` is the unit of parallel work (a top-level function of a path that never
 raises for a bad file); :class:`FoldIndex` holds the chains of many files, their
-descriptors, Cα and sequences, and is saved as an ``.npz`` archive of plain arrays (read
-back without pickle).
+descriptors, Cα and sequences, and is saved as an uncompressed ``.npz`` archive of plain
+arrays (read back without pickle; the Cα and sequences, 13 bytes a residue, mapped from the
+file, so a search reads only its candidates' rows).
 """
 
 from __future__ import annotations
 
 import io
+import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -40,6 +44,7 @@ from scipy.spatial.distance import pdist
 from core.analysis.compare import FoldMatch, fold_match
 from core.analysis.database import SkippedFile
 from core.analysis.fold_alignment import align_folds
+from core.analysis.tm_align import screen
 from core.curves.wavelets import smooth
 from core.protein.reading import read_structure
 from core.protein.structure import Structure
@@ -58,8 +63,10 @@ RANK_BLOCK = 8192
 """Index rows ranked at once."""
 MIN_RESIDUES = 20
 """Chains with fewer residues are not indexed (peptides have no fold to search)."""
-FORMAT = 1
-"""Version of the index file."""
+FORMAT = 2
+"""Version of the index file (2: uncompressed, the coordinates and sequences mapped)."""
+SCREEN_STEP = 4
+"""The candidates of :func:`search` are screened by aligning every 4th Cα of each chain."""
 FIELDS = ("format", "entries", "chains", "paths", "lengths", "descriptors", "coordinates", "sequences")
 
 
@@ -114,28 +121,39 @@ class FoldIndex:
     def __len__(self) -> int:
         return len(self.entries)
 
+    @cached_property
+    def starts(self) -> np.ndarray:
+        """(n,) int64: the first row of each chain in ``coordinates`` and ``sequences``."""
+        return np.concatenate([[0], np.cumsum(self.lengths)[:-1]]).astype(np.int64)
+
     def chain(self, k: int) -> tuple[np.ndarray, np.ndarray]:
         """The Cα (float64) and one-letter codes of chain ``k``."""
-        first = int(self.lengths[:k].sum())
-        rows = slice(first, first + int(self.lengths[k]))
-        return self.coordinates[rows].astype(np.float64), self.sequences[rows]
+        rows = slice(int(self.starts[k]), int(self.starts[k] + self.lengths[k]))
+        return np.asarray(self.coordinates[rows], dtype=np.float64), np.asarray(self.sequences[rows])
 
     def to_bytes(self) -> bytes:
-        """The index as an ``.npz`` archive (plain arrays, no pickled objects)."""
+        """The index as an uncompressed ``.npz`` archive of plain arrays (no pickled objects), so
+        that :meth:`read` maps the coordinates and sequences instead of reading them."""
         out = io.BytesIO()
-        np.savez_compressed(out, format=np.array(FORMAT), **{name: getattr(self, name) for name in FIELDS[1:]})
+        np.savez(out, format=np.array(FORMAT), **{name: getattr(self, name) for name in FIELDS[1:]})
         return out.getvalue()
 
     @classmethod
     def read(cls, path: Path) -> FoldIndex:
-        """Read an index written by :meth:`to_bytes`; ValueError when it is not one."""
+        """Read an index written by :meth:`to_bytes`, its coordinates and sequences mapped from
+        the file (read as the chains are used); ValueError when it is not one."""
         try:
             with np.load(path, allow_pickle=False) as archive:
-                arrays = {name: archive[name] for name in FIELDS}
-        except (OSError, ValueError, KeyError, EOFError) as error:
+                if int(archive["format"]) != FORMAT:
+                    raise ValueError(f"{path}: a fold index of another format version (index the files again)")
+                arrays = {name: archive[name] for name in FIELDS[1:6]}
+            arrays |= {name: _mapped(path, name) for name in FIELDS[6:]}
+        except (OSError, KeyError, EOFError, zipfile.BadZipFile) as error:
             raise ValueError(f"{path}: not a ribbonwave fold index ({type(error).__name__}: {error})") from None
-        if int(arrays.pop("format")) != FORMAT:
-            raise ValueError(f"{path}: a fold index of another format version")
+        except ValueError as error:
+            if "format version" in str(error):
+                raise
+            raise ValueError(f"{path}: not a ribbonwave fold index ({type(error).__name__}: {error})") from None
         index = cls(**arrays)
         n = len(index.entries)
         residues = int(index.lengths.sum())
@@ -143,6 +161,28 @@ class FoldIndex:
                 or len(index.coordinates) != residues or len(index.sequences) != residues):
             raise ValueError(f"{path}: a damaged fold index (its arrays disagree)")
         return index
+
+
+def _mapped(path: Path, name: str) -> np.ndarray:
+    """The array ``name`` of an uncompressed ``.npz`` archive, mapped read-only from the file."""
+    with zipfile.ZipFile(path) as archive:
+        info = archive.getinfo(f"{name}.npy")
+    if info.compress_type != zipfile.ZIP_STORED:
+        raise ValueError(f"{name} is compressed")
+    with open(path, "rb") as file:
+        file.seek(info.header_offset)
+        header = file.read(30)  # the zip entry's local header, then its name and extra field
+        file.seek(info.header_offset + 30 + int.from_bytes(header[26:28], "little")
+                  + int.from_bytes(header[28:30], "little"))
+        version = np.lib.format.read_magic(file)
+        shape, fortran, dtype = (np.lib.format.read_array_header_1_0(file) if version == (1, 0)
+                                 else np.lib.format.read_array_header_2_0(file))
+        offset = file.tell()
+    if dtype.hasobject or fortran:
+        raise ValueError(f"{name} is not a plain array")
+    if not np.prod(shape):
+        return np.zeros(shape, dtype=dtype)
+    return np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape)
 
 
 def index_structure(structure: Structure, path: Path | str = "") -> FoldIndex:
@@ -200,9 +240,15 @@ class Hit:
     match: FoldMatch
 
 
-def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candidates: int = 20) -> list[Hit]:
+def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candidates: int = 60,
+           aligned: int = 15) -> list[Hit]:
     """The ``top`` chains of ``index`` of highest TM-score (normalised by the query) among the
     ``candidates`` nearest to the query's descriptor, best first.
+
+    The candidates are screened by the TM-score of the alignment of every
+    :data:`SCREEN_STEP`-th Cα of each chain (:func:`core.analysis.tm_align.screen`, a small
+    fraction of a full alignment's work), and the best ``aligned`` of them (at least ``top``)
+    aligned in full.
 
     Parameters
     ----------
@@ -210,14 +256,21 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candi
     """
     ca = np.asarray(ca, dtype=np.float64)
     distance = descriptor_distances(index.descriptors, curve_descriptor(ca))
-    nearest = np.argsort(distance, kind="stable")[:max(candidates, top)]
+    nearest = np.argsort(distance, kind="stable")[:max(candidates, aligned, top)]
+    chains = [index.chain(row)[0] for row in nearest.tolist()]  # read from the file now
+    lengths = np.array([len(other) for other in chains], dtype=np.int64)
+    screened = screen(ca, np.concatenate(chains or [np.zeros((0, 3))]), np.concatenate([[0], np.cumsum(lengths)[:-1]]),
+                      lengths, SCREEN_STEP)
+    chosen = nearest[np.argsort(-screened, kind="stable")[:max(aligned, top)]].tolist()
+    alignments = {row: align_folds(ca, index.chain(row)[0]) for row in chosen}
+    best = sorted(chosen, key=lambda row: -alignments[row].tm_score)[:top]
     names = np.frombuffer(sequence.encode("ascii", "replace"), dtype="S1")
     hits = []
-    for row in nearest.tolist():
+    for row in best:
         other, other_names = index.chain(row)
-        alignment = align_folds(ca, other)
+        alignment = alignments[row]
         match = fold_match(ca, other, alignment.pairs_a, alignment.pairs_b, names, other_names)
         hits.append(Hit(row, str(index.entries[row]), str(index.chains[row]), str(index.paths[row]),
                         int(index.lengths[row]), float(distance[row]), match))
     hits.sort(key=lambda hit: -hit.match.tm_score_a)
-    return hits[:top]
+    return hits

@@ -1,9 +1,8 @@
 """Least-squares superposition and sequence alignment, on plain arrays (a gemmi adapter).
 
 gemmi does the work (``gemmi.superpose_positions``, ``gemmi.align_string_sequences``);
-only numpy arrays, strings and the small :class:`Superposition` leave this module. The
-searches of a structural alignment fit hundreds of subsets of pairs at once:
-:func:`fit_subsets` does them together in numpy (Kabsch's SVD), the same fits as gemmi's.
+only numpy arrays, strings and the small :class:`Superposition` leave this module (the
+structural alignment's own fits, thousands a pair, are compiled: :func:`core.analysis.tm_align.kabsch`).
 """
 
 from __future__ import annotations
@@ -69,36 +68,6 @@ def fit_closest(
             break
         motion, used = superpose(fixed[close], moving[close]), close
     return motion, used
-
-
-def fit_subsets(fixed: np.ndarray, moving: np.ndarray, subsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The least-squares superposition of each subset of paired points, all at once.
-
-    Parameters
-    ----------
-    fixed, moving : (n, 3) or (k, n, 3) paired points, finite, Å (a 2-D array is shared by
-        every subset).
-    subsets : (k, n) bool, the pairs each fit uses; at least 3 in each.
-
-    Returns
-    -------
-    rotations (k, 3, 3) and translations (k, 3): ``x -> rotation @ x + translation`` moves
-    ``moving`` onto ``fixed``.
-    """
-    weights = np.asarray(subsets, dtype=np.float64)
-    count = weights.sum(axis=1)
-    if np.any(count < MIN_PAIRS):
-        raise ValueError(f"every subset needs at least {MIN_PAIRS} pairs; the smallest has {int(count.min())}")
-    fixed, moving = np.asarray(fixed, dtype=np.float64), np.asarray(moving, dtype=np.float64)
-    centre_fixed = (weights[:, None, :] @ fixed)[:, 0] / count[:, None]
-    centre_moving = (weights[:, None, :] @ moving)[:, 0] / count[:, None]
-    covariance = np.swapaxes(weights[:, :, None] * moving, 1, 2) @ fixed - count[:, None, None] * (
-        centre_moving[:, :, None] * centre_fixed[:, None, :])
-    u, _, vt = np.linalg.svd(covariance)
-    sign = np.sign(np.linalg.det(vt.transpose(0, 2, 1) @ u.transpose(0, 2, 1)))
-    vt[:, 2] *= np.where(sign == 0, 1.0, sign)[:, None]  # a reflection becomes the best rotation
-    rotations = vt.transpose(0, 2, 1) @ u.transpose(0, 2, 1)
-    return rotations, centre_fixed - np.einsum("kij,kj->ki", rotations, centre_moving)
 
 
 def align_sequences(names_a: Sequence[str], names_b: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:

@@ -59,6 +59,7 @@ def test_search_finds_the_serine_proteases(index_file, capsys):
     status, out, _ = run(capsys, "search", DATA / "3PTB.pdb.gz", index_file, "--json", "--top", "5")
     report = json.loads(out)
     assert status == 0 and report["searched"] == 12 and report["query_length"] == 223
+    assert report["screened"] == report["aligned"] == 12  # at most the index
     hits = [(h["entry"], h["chain"]) for h in report["hits"]]
     assert hits[0] == ("3PTB", "A") and report["hits"][0]["tm_score"] == pytest.approx(1.0)
     assert set(hits[1:4]) == {("1BMA", "A"), ("1ACB", "E"), ("3SGB", "E")}

@@ -1,5 +1,6 @@
 """Start-up imports what the first window shows only: the surface code, the comparison of
-structures, matplotlib's Qt canvas and the cluster code load when first used
+structures (and numba, which compiles its alignment), matplotlib's Qt canvas and the cluster
+code load when first used
 (``benchmarks/bench_startup.py`` times the start)."""
 
 import json
@@ -13,7 +14,7 @@ ROOT = Path(__file__).resolve().parents[3]
 DEFERRED = (
     "skimage", "pywt", "dask", "distributed", "scipy.ndimage", "core.surfaces.levelled", "core.surfaces.molecular",
     "core.surfaces.volume", "core.surfaces.globe", "core.analysis.compare", "core.analysis.fold_alignment",
-    "core.fitting", "app.editor.fitting", "matplotlib.backends.backend_qtagg", "app.cli",
+    "core.analysis.tm_align", "numba", "core.fitting", "app.editor.fitting", "matplotlib.backends.backend_qtagg", "app.cli",
 )  # fmt: skip
 """Modules (and their submodules) that the first window does without."""
 FIRST_WINDOW = """

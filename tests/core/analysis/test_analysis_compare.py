@@ -7,7 +7,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from core.analysis.compare import compare_chains, pair_residues, tm_score
-from core.analysis.superpose import align_sequences, fit_closest, fit_subsets, superpose
+from core.analysis.superpose import align_sequences, fit_closest, superpose
 from core.protein.reading import read_structure
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -50,25 +50,6 @@ def test_superpose_is_least_squares(tim):
         assert other > rms
     with pytest.raises(ValueError, match="n >= 3"):
         superpose(a[:2], b[:2])
-
-
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_fits_of_many_subsets_at_once_are_gemmi_s(tim, seed):
-    """fit_subsets, batched Kabsch in numpy, gives gemmi's superposition of each subset, with
-    shared or per-subset points (a reflection would fit random subsets of noisy pairs better)."""
-    rng = np.random.default_rng(seed)
-    a, b = chain(tim, "A")[0].ca, chain(tim, "B")[0].ca
-    b = b @ Rotation.random(random_state=seed).as_matrix().T + rng.normal(scale=1.5, size=b.shape)
-    subsets = rng.random((30, len(a))) < rng.uniform(0.02, 0.5, size=(30, 1))
-    subsets[:, :3] = True
-    for moving in (b, np.broadcast_to(b, (30, *b.shape))):
-        rotations, translations = fit_subsets(a, moving, subsets)
-        for rotation, translation, subset in zip(rotations, translations, subsets):
-            direct = superpose(a[subset], b[subset])
-            assert np.allclose(rotation, direct.rotation, atol=1e-8) and np.linalg.det(rotation) == pytest.approx(1.0)
-            assert np.allclose(translation, direct.translation, atol=1e-6)
-    with pytest.raises(ValueError, match="at least 3 pairs; the smallest has 2"):
-        fit_subsets(a, b, np.arange(len(a))[None] < 2)
 
 
 def test_a_refined_fit_ignores_the_pairs_that_moved(tim):

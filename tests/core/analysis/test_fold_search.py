@@ -1,5 +1,6 @@
 """Fold descriptors of the low-level curves: invariant to position and orientation, near for one
-fold and far for others; the index file round trip and what it refuses."""
+fold and far for others; the screen of the candidates against the full alignment; the index
+file round trip and what it refuses."""
 
 from pathlib import Path
 
@@ -7,6 +8,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from core.analysis.fold_alignment import align_folds
 from core.analysis.fold_search import (
     DESCRIPTOR_SIZE,
     FoldIndex,
@@ -16,6 +18,7 @@ from core.analysis.fold_search import (
     merge,
     search,
 )
+from core.analysis.tm_align import screen
 from core.curves.wavelets import smooth
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -49,10 +52,23 @@ def test_one_fold_is_near_and_others_far(index) -> None:
 
 
 def test_search_orders_the_candidates_by_tm_score(index) -> None:
+    """Every chain screened by the alignment of every 4th Cα, the best 3 aligned in full: the
+    screen keeps elastase's own chain and trypsin."""
     ca, codes = index.chain(int(np.flatnonzero(index.entries == "1BMA")[0]))
-    hits = search(index, ca, codes.tobytes().decode(), top=3, candidates=len(index))
+    hits = search(index, ca, codes.tobytes().decode(), top=3, candidates=len(index), aligned=3)
     assert [h.entry for h in hits[:2]] == ["1BMA", "3PTB"] and hits[0].match.tm_score_a == pytest.approx(1.0)
     assert hits[0].match.tm_score_a >= hits[1].match.tm_score_a >= hits[2].match.tm_score_a
+
+
+def test_the_screen_scores_as_the_alignment_does(index) -> None:
+    """On every Cα, the screen's TM-score is the full alignment's (to its quicker final search);
+    on every 4th, trypsin and elastase still rank first for elastase, ubiquitin last."""
+    ca, _ = index.chain(int(np.flatnonzero(index.entries == "1BMA")[0]))
+    full = np.array([align_folds(ca, index.chain(k)[0]).tm_score for k in range(len(index))])
+    assert screen(ca, index.coordinates, index.starts, index.lengths, 1) == pytest.approx(full, abs=0.01)
+    quick = screen(ca, index.coordinates, index.starts, index.lengths, 4)
+    order = index.entries[np.argsort(-quick)].tolist()
+    assert order[:2] == ["1BMA", "3PTB"] and set(order[-2:]) == {"1UBQ", "2K39_CA-only"}
 
 
 def test_the_index_file_round_trip_and_refusals(index, tmp_path) -> None:
@@ -61,6 +77,14 @@ def test_the_index_file_round_trip_and_refusals(index, tmp_path) -> None:
     again = FoldIndex.read(path)
     for name in ("entries", "chains", "lengths", "descriptors", "coordinates", "sequences"):
         assert np.array_equal(getattr(again, name), getattr(index, name))
+    assert isinstance(again.coordinates, np.memmap) and isinstance(again.sequences, np.memmap)  # read per chain
+    ca, codes = index.chain(3)
+    assert [(h.row, h.match.tm_score_a) for h in search(again, ca, codes.tobytes().decode(), top=3)] == [
+        (h.row, h.match.tm_score_a) for h in search(index, ca, codes.tobytes().decode(), top=3)]
+    arrays = dict(np.load(path))
+    np.savez_compressed(tmp_path / "old.npz", **(arrays | {"format": np.array(1)}))
+    with pytest.raises(ValueError, match="another format version"):
+        FoldIndex.read(tmp_path / "old.npz")
     pickled = tmp_path / "pickled.npz"
     np.savez(pickled, entries=np.array([{"not": "an array"}], dtype=object))
     with pytest.raises(ValueError, match="not a ribbonwave fold index"):
