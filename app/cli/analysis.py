@@ -85,17 +85,23 @@ Outcome = tuple[FileAnalysis | SkippedFile, str]
 # --------------------------------------------------------------------------- analyze
 
 
-def analyze_arguments(parser: argparse.ArgumentParser) -> None:
+def batch_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the files of a run over many structures and where it runs (:func:`run_tasks`):
+    ``PATH...``, ``--jobs`` and ``--scheduler``."""
     parser.add_argument("paths", nargs="+", type=Path, metavar="PATH",
                         help="structure files or folders (searched recursively for .pdb/.ent/.cif/.mmcif, optionally .gz)")
-    parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUTDIR",
-                        help="folder for residues.csv, summary.csv, skipped.csv and fig7.png (created if needed)")
-    parser.add_argument("--overwrite", action="store_true", help="replace those files if OUTDIR already has them")
     parser.add_argument("--jobs", type=bounded(int, 1, 4096), default=len(os.sched_getaffinity(0)), metavar="N",
                         help="worker processes (default: all cores)")
     parser.add_argument("--scheduler", nargs="?", const="local", metavar="ADDRESS",
                         help="run on a Dask cluster (e.g. tcp://host:8786); without ADDRESS, a local cluster "
                         "of --jobs workers (needs the 'cluster' extra: dask[distributed])")
+
+
+def analyze_arguments(parser: argparse.ArgumentParser) -> None:
+    batch_arguments(parser)
+    parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUTDIR",
+                        help="folder for residues.csv, summary.csv, skipped.csv and fig7.png (created if needed)")
+    parser.add_argument("--overwrite", action="store_true", help="replace those files if OUTDIR already has them")
     parser.add_argument("--chains", choices=[c.value for c in ChainSelection], default="all",
                         help="every protein chain (default) or only the longest chain of each file")
     parser.add_argument("--gaps", choices=[g.value for g in Gaps], default="split",

@@ -19,7 +19,7 @@ import numpy as np
 from tqdm import tqdm
 
 from app.arguments import bounded
-from app.cli.analysis import run_tasks, structure_paths
+from app.cli.analysis import batch_arguments, run_tasks, structure_paths
 from app.cli.structure import load
 from app.errors import InputError
 from core.analysis.database import SkippedFile
@@ -31,16 +31,9 @@ from core.protein.writing import atomic_write
 
 
 def index_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("paths", nargs="+", type=Path, metavar="PATH",
-                        help="structure files or folders (searched recursively for .pdb/.ent/.cif/.mmcif, "
-                        "optionally .gz)")
+    batch_arguments(parser)
     parser.add_argument("-o", "--output", required=True, type=Path, metavar="DB", help="the index file to write (.npz)")
     parser.add_argument("--overwrite", action="store_true", help="replace DB if it exists")
-    parser.add_argument("--jobs", type=bounded(int, 1, 4096), default=len(os.sched_getaffinity(0)), metavar="N",
-                        help="worker processes (default: all cores)")
-    parser.add_argument("--scheduler", nargs="?", const="local", metavar="ADDRESS",
-                        help="run on a Dask cluster (e.g. tcp://host:8786); without ADDRESS, a local cluster "
-                        "of --jobs workers (needs the 'cluster' extra: dask[distributed])")
 
 
 def run_index(args: argparse.Namespace) -> int:

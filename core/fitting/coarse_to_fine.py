@@ -27,7 +27,7 @@ from scipy import sparse
 from core.analysis.superpose import superpose
 from core.curves.filters import level_filters
 from core.curves.splines import spline_space
-from core.protein.model import Edit, EditableModel
+from core.protein.model import Edit, EditableModel, per_segment
 from core.protein.ribbon import Ribbon
 
 STEPS_PER_LEVEL = 4
@@ -112,7 +112,7 @@ def fit_levels(
         if cancelled():
             return
         start = time.perf_counter()
-        edits: dict[int, Edit] = {}
+        steps: list[Edit] = []
         fit = superpose(model.coords[rows], target)
         n_points = 0
         for _ in range(STEPS_PER_LEVEL):
@@ -123,7 +123,7 @@ def fit_levels(
                 edit = _step(model, p, level, placed[offset:offset + k], model.coords[rows[offset:offset + k]])
                 offset += k
                 model.apply(edit)
-                edits[p.segment] = edits[p.segment].then(edit) if p.segment in edits else edit
+                steps.append(edit)
             new = superpose(model.coords[rows], target)
             settled = new.rmsd > (1.0 - SETTLED) * fit.rmsd
             fit = new
@@ -131,7 +131,7 @@ def fit_levels(
                 break
         for p in pairs:
             n_points += spline_space(min(level, model.ribbons[p.segment].level)).n_points
-        yield LevelFit(level, n_points, fit.rmsd, time.perf_counter() - start, tuple(edits.values()))
+        yield LevelFit(level, n_points, fit.rmsd, time.perf_counter() - start, tuple(per_segment(steps)))
 
 
 def _step(model: EditableModel, pairs: Pairs, level: int, target: np.ndarray, ca: np.ndarray) -> Edit:

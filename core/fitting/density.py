@@ -38,7 +38,7 @@ from core.curves.splines import spline_space
 from core.fitting.coarse_to_fine import LevelFit, pushed_to_finest
 from core.fitting.settle import FitResult, regularize_fit, settle
 from core.fitting.side_chains import fit_side_chains
-from core.protein.model import Edit, EditableModel
+from core.protein.model import Edit, EditableModel, per_segment
 from core.protein.structure import ca_rows
 from core.surfaces.volume import DensityMap, MapError
 
@@ -339,25 +339,21 @@ def refine(
     settles into the map as the side chains do, and the regularization costs less each time).
     Returns the edits, applied, one per segment."""
     correlation = atom_correlation(model, target)
-    done: dict[int, Edit] = {}
-
-    def record(edits: Sequence[Edit]) -> None:
-        for edit in edits:
-            done[edit.segment] = done[edit.segment].then(edit) if edit.segment in done else edit
+    done: list[Edit] = []
 
     def turn_side_chains() -> None:
         turned = fit_side_chains(model, segments, correlation, cancelled=cancelled)
         for edit in turned:
             model.apply(edit)
-        record(turned)
+        done.extend(turned)
 
     turn_side_chains()
     for _ in range(cycles):
         if cancelled():
             break
         again = list(fit_map_levels(model, segments, target, [level], give_way=None, cancelled=cancelled))
-        record([edit for fit in again for edit in fit.edits])
+        done.extend(edit for fit in again for edit in fit.edits)
         if regularize:
-            record(regularize_fit(model, again))
+            done.extend(regularize_fit(model, again))
         turn_side_chains()
-    return list(done.values())
+    return per_segment(done)

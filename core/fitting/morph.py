@@ -14,6 +14,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from core.fitting.coarse_to_fine import LevelFit
+from core.fitting.settle import FIT_ITERATIONS
 from core.geometry.regularize import regularized
 from core.protein.model import EditableModel
 
@@ -53,7 +54,7 @@ def morph_frames(
                 now = edit.old_points + (edit.new_points - edit.old_points) * (k / count)
                 planned = start.plan(edit.segment, now)
                 if regularize and len(planned.residues):
-                    planned = regularized(start, planned)
+                    planned = regularized(start, planned, max_iterations=FIT_ITERATIONS)
                 coords[planned.rows] = planned.new_coords
             result.append(coords)
     return result

@@ -11,7 +11,7 @@ import numpy as np
 from core.fitting.coarse_to_fine import LevelFit
 from core.geometry.regularize import regularized
 from core.geometry.validation import validate
-from core.protein.model import Edit, EditableModel
+from core.protein.model import Edit, EditableModel, per_segment
 from core.protein.structure import Structure
 
 
@@ -38,6 +38,10 @@ class FitResult:
 
 BACKBONE = ("peptide_bond", "ca_ca")
 """The flags a regularized fit may not add."""
+FIT_ITERATIONS = 60
+"""Levenberg–Marquardt steps at most when regularizing a fit: a whole chain moved onto
+another conformation, every side chain checked for clashes, takes 40–45 to settle, where
+a drag takes 4–14 (:data:`core.geometry.least_squares.MAX_ITERATIONS`)."""
 
 
 def settle(model: EditableModel, fits: list[LevelFit], *, regularize: bool = True,
@@ -74,14 +78,10 @@ def _bad_junctions(structure: Structure, coords: np.ndarray) -> int:
 def regularize_fit(model: EditableModel, fits: Sequence[LevelFit]) -> list[Edit]:
     """Regularize (and apply) what ``fits`` moved, one edit per segment: ideal peptide
     junctions, on the fitted curve, without new clashes (:func:`core.geometry.regularize.regularized`)."""
-    total: dict[int, Edit] = {}
-    for fit in fits:
-        for edit in fit.edits:
-            total[edit.segment] = total[edit.segment].then(edit) if edit.segment in total else edit
     edits = []
-    for edit in total.values():
+    for edit in per_segment(edit for fit in fits for edit in fit.edits):
         if len(edit.residues):
-            fixed = regularized(model, edit)
+            fixed = regularized(model, edit, max_iterations=FIT_ITERATIONS)
             step = Edit(edit.segment, edit.new_points, edit.new_points, fixed.residues, fixed.rows,
                         model.coords[fixed.rows], fixed.new_coords)  # from the fitted state
             model.apply(step)

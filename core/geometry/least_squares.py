@@ -19,11 +19,10 @@ DAMPING = 1e-2
 STALL = 3e-3
 """Stop when nothing would be flagged, or anyway when a step is predicted to lower the
 objective by less than this fraction."""
-MAX_ITERATIONS = 60
-"""Levenberg–Marquardt steps at most per fit: a drag typically takes 4–14 (one that has
-not settled by 25 is over-constrained, and more steps rarely remove a flag); a whole chain
-moved by a fit onto another conformation, every side chain checked for clashes, takes
-40–45 and settles only with them."""
+MAX_ITERATIONS = 25
+"""Levenberg–Marquardt steps at most per fit, unless told otherwise (typically 4–14 are
+taken; edits that have not settled by then are over-constrained, and more steps rarely
+remove a flag)."""
 
 
 class State(Protocol):
@@ -66,12 +65,12 @@ class Fit:
     iterations: int
 
 
-def levenberg_marquardt(problem: Problem) -> Fit:
+def levenberg_marquardt(problem: Problem, max_iterations: int = MAX_ITERATIONS) -> Fit:
     """Minimize ½ Σ residual² of ``problem`` from its start state.
 
     Steps longer than the problem allows are scaled down (and never end the fit); a fit
     ends when nothing is flagged, when a step is predicted to gain less than
-    :data:`STALL` of the objective, or after :data:`MAX_ITERATIONS` steps.
+    :data:`STALL` of the objective, or after ``max_iterations`` steps.
     """
     state = problem.start()
     residual, terms = problem.evaluate(state)
@@ -80,7 +79,7 @@ def levenberg_marquardt(problem: Problem) -> Fit:
     cost = 0.5 * residual @ residual
     damping, growth = DAMPING, 2.0
     iterations = 0
-    for iterations in range(1, MAX_ITERATIONS + 1):
+    for iterations in range(1, max_iterations + 1):
         step = -normal.solve(jacobian.T @ residual, damping)
         per_body = problem.per_body(step)
         reach = problem.reach(per_body)

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.geometry.least_squares import levenberg_marquardt
+from core.geometry.least_squares import MAX_ITERATIONS, levenberg_marquardt
 from core.geometry.restraints import CHI1, Restraints
 from core.protein.model import Edit, EditableModel
 from core.protein.structure import Structure
@@ -79,7 +79,7 @@ class Relaxation:
     settled: bool
 
 
-def regularized(model: EditableModel, edit: Edit, *, flank: int = FLANK) -> Edit:
+def regularized(model: EditableModel, edit: Edit, *, flank: int = FLANK, max_iterations: int = MAX_ITERATIONS) -> Edit:
     """The edit ``edit`` followed by regularization, as one :class:`Edit`.
 
     ``model`` may hold ``edit``'s old or new state (only ``edit.rows`` differ between the
@@ -96,7 +96,8 @@ def regularized(model: EditableModel, edit: Edit, *, flank: int = FLANK) -> Edit
     u = ribbon.residue_u[free]
     anchors = ribbon.space.evaluate(edit.new_points, u)
     tangents = ribbon.space.evaluate(edit.new_points, u, 1)
-    result = relax(model.structure, after, segment.residue_index[free], anchors, tangents, before)
+    result = relax(model.structure, after, segment.residue_index[free], anchors, tangents, before,
+                   max_iterations=max_iterations)
     return Edit(edit.segment, edit.old_points, edit.new_points, free, result.rows, before[result.rows], result.coords)
 
 
@@ -129,6 +130,8 @@ def relax(
     anchors: np.ndarray,
     tangents: np.ndarray,
     reference: np.ndarray | None = None,
+    *,
+    max_iterations: int = MAX_ITERATIONS,
 ) -> Relaxation:
     """Move ``residues`` (rigid, turning carbonyls and clashing side chains) to ideal
     junctions, on the curve, without new clashes.
@@ -142,6 +145,7 @@ def relax(
     tangents : (m, 3) curve tangents there (any length).
     reference : (n_atoms, 3) positions before the edit: pairs that overlapped there may
         keep that overlap (default: ``coords``).
+    max_iterations : Levenberg–Marquardt steps at most per fit.
 
     Returns
     -------
@@ -158,7 +162,8 @@ def relax(
     if len(residues) == 0:
         return Relaxation(np.zeros(0, dtype=np.int64), np.zeros((0, 3)), 0, 0.0, True)
     anchors, tangents = np.asarray(anchors, float), np.asarray(tangents, float)
-    backbone = _solve(Restraints(structure, coords, residues, anchors, tangents, reference, side_chains=False))
+    backbone = _solve(Restraints(structure, coords, residues, anchors, tangents, reference, side_chains=False),
+                      max_iterations)
     if backbone.settled:
         return backbone
     # something would still be flagged: side chains that clash may turn too (χ1), from here
@@ -167,7 +172,7 @@ def relax(
     problem = Restraints(structure, start, residues, anchors, tangents, reference, side_chains=True)
     if not problem.axis[:, CHI1].any():  # no side chain clashes: nothing new to try
         return backbone
-    result = _solve(problem)
+    result = _solve(problem, max_iterations)
     return Relaxation(result.rows, result.coords, backbone.iterations + result.iterations, result.cost, result.settled)
 
 
@@ -179,8 +184,8 @@ def _with_flanks(residues: np.ndarray, flank: int, n_residues: int) -> np.ndarra
     return np.unique(spread[(spread >= 0) & (spread < n_residues)])
 
 
-def _solve(problem: Restraints) -> Relaxation:
+def _solve(problem: Restraints, max_iterations: int) -> Relaxation:
     """Levenberg–Marquardt on ``problem`` from the start positions."""
-    fit = levenberg_marquardt(problem)
+    fit = levenberg_marquardt(problem, max_iterations)
     coords = problem.atoms(fit.state)[problem.rows].copy()
     return Relaxation(problem.rows, coords, fit.iterations, fit.cost, not problem.violated(fit.residual))

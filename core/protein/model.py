@@ -8,6 +8,7 @@ and redone bit for bit. Atoms of residues the edit does not reach are never rewr
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -58,6 +59,15 @@ class Edit:
         new[np.searchsorted(rows, later.rows)] = later.new_coords
         residues = np.union1d(self.residues, later.residues)
         return Edit(self.segment, self.old_points, later.new_points, residues, rows, old, new)
+
+
+def per_segment(edits: Iterable[Edit]) -> list[Edit]:
+    """``edits``, applied one after another, as one edit per segment (:meth:`Edit.then`), in
+    the order the segments first appear."""
+    total: dict[int, Edit] = {}
+    for edit in edits:
+        total[edit.segment] = total[edit.segment].then(edit) if edit.segment in total else edit
+    return list(total.values())
 
 
 class EditableModel:
