@@ -18,7 +18,7 @@ from core.analysis.compare import PAIRINGS
 from core.analysis.superpose import superpose
 from core.fitting.coarse_to_fine import Pairs
 from core.fitting.conformation import SAME_FOLD, fit_conformation, fold_similarity, pair_segments
-from core.fitting.density import RESOLUTION, MapTarget, fit_map, heavy_atoms
+from core.fitting.density import RESOLUTION, MapTarget, fit_map, heavy_atoms, level_resolution
 from core.fitting.morph import morph_frames
 from core.fitting.settle import FitResult
 from core.geometry.validation import validate
@@ -83,11 +83,12 @@ def run_fit(args: argparse.Namespace) -> int:
         raise InputError(f"{error} (pass --overwrite to replace it)") from None
     except (ValueError, OSError) as error:
         raise InputError(str(error)) from None
-    what = report.pop("what")
+    what, seen_at = report.pop("what"), report.pop("seen_at", None)
+    levels = [{"level": f.level, "control_points": f.control_points, measure: round(f.score, 4),
+               "seconds": round(f.seconds, 4)} | ({} if seen_at is None else {"resolution": round(seen_at(f.level), 2)})
+              for f in result.levels]
     report.update({
-        "model": str(args.file), "target": str(args.to),
-        "levels": [{"level": f.level, "control_points": f.control_points, measure: round(f.score, 4),
-                    "seconds": round(f.seconds, 4)} for f in result.levels],
+        "model": str(args.file), "target": str(args.to), "levels": levels,
         "dropped_levels": result.dropped, "regularized": args.regularize, "refined": bool(result.refinement),
         "validation": {kind: {"before": before[kind], "after": after[kind]} for kind, _ in CHECKED},
         "output": str(written),
@@ -97,8 +98,9 @@ def run_fit(args: argparse.Namespace) -> int:
         return 0
     name, unit = ("Cα rmsd", " Å") if measure == "rmsd" else ("correlation", "")
     print(f"{what}; {name} after each level:")
-    for f in result.levels:
-        print(f"  level {f.level}: {f.control_points:4d} control points, {name} {f.score:6.3f}{unit}, "
+    for f, level in zip(result.levels, levels):
+        seen = f" at {level['resolution']:4.1f} Å" if "resolution" in level else ""
+        print(f"  level {f.level}: {f.control_points:4d} control points, {name} {f.score:6.3f}{unit}{seen}, "
               f"{f.seconds:6.2f} s")
     if result.dropped:
         print(f"  levels {', '.join(map(str, result.dropped))} undone: the regularized model kept more bad peptide "
@@ -150,7 +152,9 @@ def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
                       args.levels)
     rows = heavy_atoms(model)
     report = {"resolution": args.resolution, "segments": len(segments),
-              "what": f"{len(segments)} segment(s) into the map at {args.resolution:g} Å"}
+              "what": f"{len(segments)} segment(s) into the map at {args.resolution:g} Å (each level into the map "
+                      "blurred as that level sees it)",
+              "seen_at": lambda level: level_resolution(model, segments, level, args.resolution)}
     return result, report, "cc", lambda: target.correlation(model.coords[rows])
 
 

@@ -27,7 +27,7 @@ from app.editor.document import Document
 from app.editor.scene.overlay import Compared, chain_segments
 from core.fitting.coarse_to_fine import LevelFit, fit_levels
 from core.fitting.conformation import SAME_FOLD, fold_similarity, pair_segments
-from core.fitting.density import MapTarget, fit_map_levels, heavy_atoms, refine
+from core.fitting.density import MapTarget, fit_map_levels, heavy_atoms, level_resolution, refine
 from core.fitting.settle import settle
 from core.protein.model import Edit
 from core.surfaces.volume import DensityMap
@@ -45,8 +45,8 @@ class FitTarget:
     name: str
     """As the undo steps name it: ``'map'``, ``'4AKE A'``."""
     fits: Fits
-    score: Callable[[float], str]
-    """A level's score for people: ``'CC 0.953'``, ``'Cα rmsd 1.21 Å'``."""
+    score: Callable[[LevelFit], str]
+    """A level's score for people: ``'CC 0.953 at 13 Å'`` (the map as that level sees it), ``'Cα rmsd 1.21 Å'``."""
     refine: Refines | None = None
     """For a map: the side chains turned into it and the finest level fitted again."""
 
@@ -63,9 +63,12 @@ def map_target(document: Document, density: DensityMap, resolution: float) -> Fi
     :class:`core.surfaces.volume.MapError` where the map does not overlap the model)."""
     model, segments = document.model, edited_chain(document)
     target = MapTarget(density, resolution, model.coords[heavy_atoms(model)])
+
+    def seen_at(level: int) -> float:
+        return level_resolution(model, segments, level, resolution)
     return FitTarget("map", lambda levels, cancelled: fit_map_levels(model, segments, target, levels,
                                                                        cancelled=cancelled),
-                     lambda cc: f"CC {cc:.3f}",
+                     lambda fit: f"CC {fit.score:.3f} at {seen_at(fit.level):.3g} Å",
                      lambda level, cancelled: refine(model, segments, target, level, cancelled=cancelled))
 
 
@@ -83,7 +86,7 @@ def compared_target(document: Document, compared: Compared) -> FitTarget:
                          f"{used}-paired residues): nothing to fit onto")
     return FitTarget(compared.name.strip(), lambda levels, cancelled: fit_levels(model, pairs, levels, document.ca_rows,
                                                                          cancelled=cancelled),
-                     lambda rmsd: f"Cα rmsd {rmsd:.2f} Å")
+                     lambda fit: f"Cα rmsd {fit.score:.2f} Å")
 
 
 def levels_to_fit(document: Document, coarse_to_fine: bool) -> list[int]:
@@ -121,11 +124,11 @@ def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent
                 break
             if fit.edits:
                 document.push_applied(fit.edits, f"Fit to {target.name} at level {fit.level} "
-                                                 f"({target.score(fit.score)})")
+                                                 f"({target.score(fit)})")
             kept.append(fit)
             progress.setValue(len(kept))
             if len(kept) < len(levels):
-                progress.setLabelText(f"Level {fit.level}: {target.score(fit.score)}. Fitting at level "
+                progress.setLabelText(f"Level {fit.level}: {target.score(fit)}. Fitting at level "
                                       f"{levels[len(kept)]}…")
         if len(levels) > 1 and kept and not progress.wasCanceled():
             kept = _settle(document, target, kept, progress, cancelled, undo)

@@ -97,6 +97,7 @@ def test_fit_into_a_map_raises_the_correlation_and_nears_the_target(capsys, tmp_
                           "-o", out, "--json")
     report = json.loads(text)
     assert status == 0 and report["resolution"] == 10.0 and report["refined"]
+    assert [level["resolution"] for level in report["levels"]] == [30.0, 30.0, 30.0, 30.0, 26.75, 13.38]
     cc = [level["cc"] for level in report["levels"]]
     assert cc[-1] > cc[0] and cc[-1] > 0.96 and report["final"] > 0.96
     fitted = read_structure(out)

@@ -1,4 +1,5 @@
-"""Side chains turned into a density map: χ rotors, their analytic gradient, the fit (#19)."""
+"""Fitting into density maps (#19): the map blurred for the levels; side chains turned into it
+(χ rotors, their analytic gradient, the fit)."""
 
 from pathlib import Path
 
@@ -6,7 +7,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from core.fitting.density import MapTarget, atom_correlation, gaussian_sigma, heavy_atoms
+from core.fitting.density import MapTarget, atom_correlation, fit_map, gaussian_sigma, heavy_atoms
 from core.fitting.side_chains import fit_side_chains, side_chain_rotors
 from core.geometry.topology import topology
 from core.geometry.validation import validate
@@ -23,14 +24,41 @@ def adk() -> EditableModel:
     return EditableModel(read_structure(DATA / "1AKE_adk_closed.pdb.gz"))
 
 
-def _own_map(model: EditableModel) -> MapTarget:
-    """The model's own heavy atoms at RESOLUTION, on a 1 Å grid."""
+def _own_map(model: EditableModel, resolution: float = RESOLUTION, around: EditableModel | None = None) -> MapTarget:
+    """The model's own heavy atoms at ``resolution`` Å, on a 1 Å grid, around the heavy atoms
+    of ``around`` (the model itself by default)."""
     coords = model.coords[heavy_atoms(model)]
     origin = np.floor(coords.min(axis=0)) - 12.0
     grid = np.zeros(tuple(int(n) for n in np.ceil(coords.max(axis=0) + 12.0 - origin)))
     np.add.at(grid, tuple(np.round(coords - origin).astype(int).T), 1.0)
-    density = DensityMap(ndimage.gaussian_filter(grid, gaussian_sigma(RESOLUTION)), origin, np.eye(3))
-    return MapTarget(density, RESOLUTION, coords)
+    density = DensityMap(ndimage.gaussian_filter(grid, gaussian_sigma(resolution)), origin, np.eye(3))
+    around = model if around is None else around
+    return MapTarget(density, resolution, around.coords[heavy_atoms(around)])
+
+
+def test_a_map_blurred_for_the_levels_is_the_map_at_that_resolution(adk: EditableModel) -> None:
+    fine, coarse = _own_map(adk, 6.0), _own_map(adk, 10.0)
+    blurred = fine.blurred(10.0)
+    assert fine.blurred(5.0) is fine and blurred.resolution == 10.0 and blurred.spacing == coarse.spacing
+    rows = heavy_atoms(adk)
+    rng = np.random.default_rng(4)
+    for shift in (0.0, 1.5, 4.0):  # the model in place and moved off it
+        coords = adk.coords[rows] + shift * rng.normal(size=3)
+        assert blurred.correlation(coords) == pytest.approx(coarse.correlation(coords), abs=0.005)
+    assert fine.correlation(adk.coords[rows] + 2.0) < blurred.correlation(adk.coords[rows] + 2.0)  # wider basin
+
+
+def test_a_fit_into_a_6_angstrom_map_takes_the_levels_through_it_blurred(adk: EditableModel) -> None:
+    """4AKE into a 6 Å map of 1AKE: the levels fitted into it as it is stall 2.5 Å from the
+    target (the finer map's detail traps the coarse control points); blurred, they do not."""
+    start = EditableModel(read_structure(DATA / "4AKE_adk_open.pdb.gz"))
+    target = _own_map(adk, 6.0, around=start)
+    ca = start.structure.atoms.name == "CA"
+    result = fit_map(start, [0], target, range(0, 7))
+    assert [fit.level for fit in result.levels][-1] >= 5 and result.refinement
+    rmsd = np.sqrt(np.mean(np.sum((start.coords[ca] - adk.coords[ca]) ** 2, axis=1)))
+    assert rmsd < 2.0 and target.correlation(start.coords[heavy_atoms(start)]) > 0.94
+    assert validate(start.structure, start.coords).counts["peptide_bond"] == 0
 
 
 def test_the_rotors_are_the_iupac_torsions_and_keep_every_bond(adk: EditableModel) -> None:
