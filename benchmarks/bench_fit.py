@@ -16,7 +16,8 @@ residues paired by number, in both directions.
   0-6, then regularized and refined): correlation, Cα rmsd to the target (no
   superposition: the map sets the frame) and time. Then the same into maps made another
   way (:func:`xray_like_map`: each atom its electrons blurred by its B-factor, the Fourier
-  transform cut sharply at the resolution, and noise). Anchor (published, not run here):
+  transform cut sharply at the resolution, and noise), and into gemmi's electron density
+  of the target (:func:`gemmi_map`). Anchor (published, not run here):
   iMODFIT fits GroEL (1AON into a 10 Å map of 1OEL) to 1.78 Å Cα rmsd, CC 0.982, in 244 s.
 * ``--others DIR``: the same for other pairs of conformations or homologues, files of DIR
   (:data:`OTHER_PAIRS`, chain A of each), the start first placed on the target by its
@@ -131,7 +132,7 @@ def xray_like_map(structure: Structure, resolution: float, noise: float = 0.3, s
     spectrum = np.fft.rfftn(grid)
     k = np.meshgrid(*(np.fft.fftfreq(n) for n in shape[:2]), np.fft.rfftfreq(shape[2]), indexing="ij")
     spectrum[np.sqrt(sum(f**2 for f in k)) > 1.0 / resolution] = 0.0
-    values = np.fft.irfftn(spectrum, shape)
+    values = np.fft.irfftn(spectrum, shape, axes=(0, 1, 2))
     values += noise * values.std() * np.random.default_rng(seed).standard_normal(shape)
     return DensityMap(values.astype(np.float32), origin, np.eye(3))
 
