@@ -16,10 +16,11 @@ flags that the :attr:`~LiveValidation.triage_filter` shows (by default those the
 edits made or worsened, and the severe ones: :mod:`core.geometry.triage`), sorted out after
 every check at the cost of a dictionary look-up per flag.
 
-During a drag the report is brought up to date from the event loop, at most every
-:data:`DRAG_INTERVAL_MS` (the residues moved meanwhile are checked together), so a drag
-step does not pay for a check; every other change, the end of a drag included, is
-checked at once.
+During a drag the report is brought up to date at most every :data:`DRAG_INTERVAL_MS`
+(the residues moved meanwhile are checked together): by the first drag step after the
+interval, within the step, so its views change with the frame the step draws (each event-loop
+turn that changes a widget composes the whole window once more); and, where the drag pauses
+for as long, by a timer. Every other change, the end of a drag included, is checked at once.
 """
 
 from __future__ import annotations
@@ -63,7 +64,7 @@ class LiveValidation(QObject):
         self.local = False
         """Whether the last check was a local one."""
         self.late = False
-        """Whether the last check was a drag's deferred one, run after its change was drawn."""
+        """Whether the last check was a drag's deferred one, run after its change was drawn (the drag paused)."""
         self._pending: np.ndarray | None = None  # residues (table rows) moved since the last check
         self._finished = 0.0
         self._timer = QTimer(self)
@@ -114,10 +115,8 @@ class LiveValidation(QObject):
     def _check_change(self, change: Change) -> None:
         residues = self.document.structure.segments[change.segment].residue_index[change.residues]
         self._pending = residues if self._pending is None else np.union1d(self._pending, residues)
-        if self.document.dragging:  # checked in an event-loop turn of its own, not in the drag step
-            if not self._timer.isActive():
-                wait = DRAG_INTERVAL_MS - 1e3 * (time.perf_counter() - self._finished)
-                self._timer.start(max(0, int(wait) + 1))
+        if self.document.dragging and 1e3 * (time.perf_counter() - self._finished) < DRAG_INTERVAL_MS:
+            self._timer.start(DRAG_INTERVAL_MS)  # checked by a later step, or once the drag pauses this long
             return
         self._check_pending()
 

@@ -20,7 +20,6 @@ from PySide6.QtWidgets import (
     QGridLayout,
     QGroupBox,
     QHBoxLayout,
-    QHeaderView,
     QLabel,
     QStyle,
     QTreeWidget,
@@ -91,7 +90,6 @@ class ValidationPanel(QWidget):
         self.offenders.setRootIsDecorated(False)
         self.offenders.setUniformRowHeights(True)
         self.offenders.header().setStretchLastSection(False)
-        self.offenders.header().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         self.offenders.headerItem().setToolTip(0, self.severity.toolTip())
         self.offenders.headerItem().setToolTip(1, "new: not in the structure as read; worse: more severe than there")
         self.offenders.setMinimumHeight(LIST_LINES * self.fontMetrics().lineSpacing())
@@ -179,27 +177,35 @@ class ValidationPanel(QWidget):
         self.refresh()
 
     def _fill_list(self) -> None:
+        """Fill the list; where its rows are as many as before (as in most drag steps), only the
+        texts that changed change: nothing is laid out again, so the list repaints with the
+        frame rather than in an event-loop turn of its own (each composes the whole window)."""
         triaged = self.validation.triaged
         if triaged is None:
             return
         self.listed = triaged.flags[:LISTED]
-        items = []
-        for flag, novelty in zip(self.listed, triaged.novelty):
-            item = QTreeWidgetItem([f"{flag.severity:.1f}", "" if novelty == AS_READ else novelty, flag.where,
-                                    _problem(flag)])
-            item.setTextAlignment(0, Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-            if novelty != AS_READ:
-                font = item.font(0)
-                font.setBold(True)
-                for column in range(len(COLUMNS)):
-                    item.setFont(column, font)
-            items.append(item)
+        rows = [([f"{flag.severity:.1f}", "" if novelty == AS_READ else novelty, flag.where, _problem(flag)],
+                 novelty != AS_READ) for flag, novelty in zip(self.listed, triaged.novelty)]
         more = len(triaged.flags) - len(self.listed)
         if more:
-            items.append(QTreeWidgetItem(["", "", f"… and {more} more", ""]))
-        self.offenders.clear()
-        self.offenders.addTopLevelItems(items)
+            rows.append((["", "", f"… and {more} more", ""], False))
         self.shown.setText(f"{len(triaged.flags)} of {len(self.validation.report.flags)} shown")
+        tree = self.offenders
+        if tree.topLevelItemCount() != len(rows):
+            tree.clear()
+            tree.addTopLevelItems([QTreeWidgetItem(len(COLUMNS)) for _ in rows])
+            tree.doItemsLayout()
+        for k, (texts, bold) in enumerate(rows):
+            item = tree.topLevelItem(k)
+            font = item.font(0)
+            font.setBold(bold)
+            for column, text in enumerate(texts):
+                item.setText(column, text)  # no change where the text is the same
+                item.setFont(column, font)
+            item.setTextAlignment(0, Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+        for column in range(len(COLUMNS)):  # wider where a text needs it, never narrower
+            if tree.sizeHintForColumn(column) > tree.columnWidth(column):
+                tree.resizeColumnToContents(column)
 
     def _set_kinds(self) -> None:
         kinds = frozenset(kind for kind, box in self.kind_boxes.items() if box.isChecked())

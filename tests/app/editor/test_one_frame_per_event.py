@@ -9,6 +9,7 @@ from PySide6.QtGui import QWheelEvent
 from PySide6.QtWidgets import QApplication
 from pytestqt.qtbot import QtBot
 
+from app.editor.live_validation import DRAG_INTERVAL_MS
 from app.editor.main_window import MainWindow
 from app.editor.scene.scene import STILL_AFTER_MS, Layer
 
@@ -31,6 +32,15 @@ def _frames_of(qtbot: QtBot, window: MainWindow, send) -> int:  # noqa: ANN001 (
     return window.plotter.frames - before
 
 
+def _point_of(window: MainWindow, index: int) -> QPoint:
+    """Where control point ``index`` of the level shown lies in the view."""
+    view = window.plotter
+    view.renderer.SetWorldPoint(*window.document.level_curve().control_points[index], 1.0)
+    view.renderer.WorldToDisplay()
+    x, y, _ = view.renderer.GetDisplayPoint()
+    return QPoint(round(x / view.devicePixelRatioF()), round(view.height() - 1 - y / view.devicePixelRatioF()))
+
+
 def test_each_event_draws_one_frame(qtbot: QtBot, open_window: Opener) -> None:
     window = open_window("1AYE.pdb.gz")
     document = window.document
@@ -40,11 +50,7 @@ def test_each_event_draws_one_frame(qtbot: QtBot, open_window: Opener) -> None:
     assert _frames_of(qtbot, window, lambda: qtbot.keyClick(slider, Qt.Key.Key_Right)) == 1
 
     index = int(window.scene.shown_control_points()[4])
-    renderer = view.renderer
-    renderer.SetWorldPoint(*document.level_curve().control_points[index], 1.0)
-    renderer.WorldToDisplay()
-    x, y, _ = renderer.GetDisplayPoint()
-    at = QPoint(round(x / view.devicePixelRatioF()), round(view.height() - 1 - y / view.devicePixelRatioF()))
+    at = _point_of(window, index)
     assert _frames_of(qtbot, window, lambda: qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=at)) == 1
     assert document.pick is not None and document.pick.index == index
     assert _frames_of(qtbot, window, lambda: qtbot.mouseMove(view, at + QPoint(30, 20))) == 1
@@ -59,6 +65,38 @@ def test_each_event_draws_one_frame(qtbot: QtBot, open_window: Opener) -> None:
     distance = view.camera.distance
     assert _frames_of(qtbot, window, lambda: QApplication.sendEvent(view, wheel)) == 1
     assert view.camera.distance < distance
+
+
+def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, open_window: Opener) -> None:
+    """Each event-loop turn that changes a widget composes the whole window once more: a drag
+    step checks the moved residues itself once the interval is over, and the list of flags
+    changes its texts in place, so the dock changes in the step's one composition."""
+    window = open_window("1UBQ.pdb.gz")
+    view, document, tree = window.plotter, window.document, window.validation_panel.offenders
+    compositions = []
+    view.aboutToCompose.connect(lambda: compositions.append(1))
+    at = _point_of(window, int(window.scene.shown_control_points()[3]))
+    qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=at)
+    qtbot.mouseMove(view, at + QPoint(4, 0))  # past a click's reach: a drag
+    alike = 0
+    for m in range(1, 7):
+        qtbot.wait(DRAG_INTERVAL_MS + 20)  # the check is due
+        rows, first = tree.topLevelItemCount(), tree.topLevelItem(0)
+        compositions.clear()
+        qtbot.mouseMove(view, at + QPoint(4 + m, 0))
+        assert not window.validation.pending and not window.validation.late  # checked within the step
+        qtbot.wait(60)
+        assert window.plotter.frames and len(compositions) >= 1
+        if tree.topLevelItemCount() == rows:
+            alike += 1
+            assert tree.topLevelItem(0) is first and len(compositions) == 1
+    assert alike >= 3
+    qtbot.mouseMove(view, at + QPoint(50, 35))  # right after a check: left for later
+    assert window.validation.pending
+    qtbot.waitUntil(lambda: not window.validation.pending, timeout=2000)  # the drag paused: checked
+    assert window.validation.late
+    qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=at + QPoint(50, 35))
+    assert document.undo_stack.count() == 1
 
 
 def test_a_screenshot_shows_a_change_not_drawn_yet(open_window: Opener) -> None:
