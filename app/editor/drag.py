@@ -94,6 +94,8 @@ class _Grab:
     """(k, 3) the axes Shift may constrain the motion to: x, y, z, or those of a box face's plane."""
     moved: bool = False
     """Whether the pointer has gone CLICK_PIXELS from the press (a drag, not a click)."""
+    shown: np.ndarray | None = None
+    """The displacement previewed last (a release where the last move left the pointer shows nothing new)."""
 
 
 class DragController:
@@ -123,7 +125,8 @@ class DragController:
             axis = grab.axes[np.argmax(np.abs(grab.axes @ displacement))]
             displacement = axis * float(axis @ displacement)
         grab.moved = grab.moved or float(np.linalg.norm(displacement)) >= CLICK_PIXELS * grab.pixel
-        if grab.moved:
+        if grab.moved and not (grab.shown is not None and np.array_equal(displacement, grab.shown)):
+            grab.shown = displacement
             if grab.index is not None:
                 self.document.preview_move(grab.index, displacement)
             else:

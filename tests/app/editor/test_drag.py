@@ -39,6 +39,22 @@ def test_dragging_a_control_point_moves_it_in_the_view_plane(ubiquitin: Document
     assert ubiquitin.undo_stack.text(0) == f"Move point {index} at level {ubiquitin.shown_level():.2f}"
 
 
+def test_a_release_where_the_last_move_left_the_pointer_previews_nothing_again(ubiquitin: Document) -> None:
+    controller = DragController(ubiquitin)
+    index, start = _shown_point(ubiquitin, 4)
+    changes = []
+    ubiquitin.changed.connect(changes.append)
+    controller.handle(_event("press", start))
+    controller.handle(_event("move", start + [2.0, 1.0, 0.0]))
+    controller.handle(_event("move", start + [2.0, 1.0, 0.0]))  # the same pixel again
+    assert len(changes) == 1
+    controller.handle(_event("release", start + [2.0, 1.0, 0.0]))
+    assert len(changes) == 2  # the undo step only (regularized)
+    assert ubiquitin.undo_stack.count() == 1
+    ubiquitin.undo_stack.undo()
+    np.testing.assert_allclose(ubiquitin.level_curve().control_points[index], start, atol=1e-9)
+
+
 def test_a_slanted_view_moves_the_point_in_the_plane_facing_the_camera(ubiquitin: Document) -> None:
     controller = DragController(ubiquitin)
     index, start = _shown_point(ubiquitin, 3)
