@@ -4,11 +4,13 @@ the view once, however many views change; a screenshot shows the current state a
 from collections.abc import Callable
 
 import numpy as np
+import pytest
 from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtGui import QWheelEvent
 from PySide6.QtWidgets import QApplication
 from pytestqt.qtbot import QtBot
 
+from app.editor import live_validation
 from app.editor.live_validation import DRAG_INTERVAL_MS
 from app.editor.main_window import MainWindow
 from app.editor.scene.scene import STILL_AFTER_MS, Layer
@@ -67,7 +69,8 @@ def test_each_event_draws_one_frame(qtbot: QtBot, open_window: Opener) -> None:
     assert view.camera.distance < distance
 
 
-def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, open_window: Opener) -> None:
+def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, open_window: Opener,
+                                                                monkeypatch: pytest.MonkeyPatch) -> None:
     """Each event-loop turn that changes a widget composes the whole window once more: a drag
     step checks the moved residues itself once the interval is over, and the list of flags
     changes its texts in place, so the dock changes in the step's one composition."""
@@ -91,9 +94,10 @@ def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, op
             alike += 1
             assert tree.topLevelItem(0) is first and len(compositions) == 1
     assert alike >= 3
+    monkeypatch.setattr(live_validation, "DRAG_INTERVAL_MS", 1000)  # however slow the machine
     qtbot.mouseMove(view, at + QPoint(50, 35))  # right after a check: left for later
     assert window.validation.pending
-    qtbot.waitUntil(lambda: not window.validation.pending, timeout=2000)  # the drag paused: checked
+    qtbot.waitUntil(lambda: not window.validation.pending, timeout=5000)  # the drag paused: checked
     assert window.validation.late
     qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=at + QPoint(50, 35))
     assert document.undo_stack.count() == 1
