@@ -178,8 +178,9 @@ class ValidationPanel(QWidget):
 
     def _fill_list(self) -> None:
         """Fill the list; where its rows are as many as before (as in most drag steps), only the
-        texts that changed change: nothing is laid out again, so the list repaints with the
-        frame rather than in an event-loop turn of its own (each composes the whole window)."""
+        texts that changed change and the columns only widen: nothing is laid out again, so the
+        list repaints with the frame rather than in an event-loop turn of its own (each composes
+        the whole window)."""
         triaged = self.validation.triaged
         if triaged is None:
             return
@@ -191,7 +192,8 @@ class ValidationPanel(QWidget):
             rows.append((["", "", f"… and {more} more", ""], False))
         self.shown.setText(f"{len(triaged.flags)} of {len(self.validation.report.flags)} shown")
         tree = self.offenders
-        if tree.topLevelItemCount() != len(rows):
+        refilled = tree.topLevelItemCount() != len(rows)
+        if refilled:
             tree.clear()
             tree.addTopLevelItems([QTreeWidgetItem(len(COLUMNS)) for _ in rows])
             tree.doItemsLayout()
@@ -203,8 +205,8 @@ class ValidationPanel(QWidget):
                 item.setText(column, text)  # no change where the text is the same
                 item.setFont(column, font)
             item.setTextAlignment(0, Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-        for column in range(len(COLUMNS)):  # wider where a text needs it, never narrower
-            if tree.sizeHintForColumn(column) > tree.columnWidth(column):
+        for column in range(len(COLUMNS)):  # to the texts when refilled, else only wider where a text needs it
+            if refilled or tree.sizeHintForColumn(column) > tree.columnWidth(column):
                 tree.resizeColumnToContents(column)
 
     def _set_kinds(self) -> None:
