@@ -18,7 +18,7 @@ from core.analysis.compare import PAIRINGS
 from core.analysis.superpose import superpose
 from core.fitting.coarse_to_fine import Pairs
 from core.fitting.conformation import SAME_FOLD, fit_conformation, fold_similarity, pair_segments
-from core.fitting.density import RESOLUTION, MapTarget, fit_map, heavy_atoms, level_resolution
+from core.fitting.density import RESOLUTION, MapTarget, fit_map, heavy_atoms
 from core.fitting.morph import morph_frames
 from core.fitting.settle import FitResult
 from core.geometry.validation import validate
@@ -83,10 +83,12 @@ def run_fit(args: argparse.Namespace) -> int:
         raise InputError(f"{error} (pass --overwrite to replace it)") from None
     except (ValueError, OSError) as error:
         raise InputError(str(error)) from None
-    what, seen_at = report.pop("what"), report.pop("seen_at", None)
+    what = report.pop("what")
     levels = [{"level": f.level, "control_points": f.control_points, measure: round(f.score, 4),
-               "seconds": round(f.seconds, 4)} | ({} if seen_at is None else {"resolution": round(seen_at(f.level), 2)})
-              for f in result.levels]
+               "seconds": round(f.seconds, 4)} for f in result.levels]
+    for level, f in zip(levels, result.levels):
+        if f.resolution is not None:  # a map, as that level saw it
+            level["resolution"] = round(f.resolution, 2)
     report.update({
         "model": str(args.file), "target": str(args.to), "levels": levels,
         "dropped_levels": result.dropped, "regularized": args.regularize, "refined": bool(result.refinement),
@@ -153,8 +155,7 @@ def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
     rows = heavy_atoms(model)
     report = {"resolution": args.resolution, "segments": len(segments),
               "what": f"{len(segments)} segment(s) into the map at {args.resolution:g} Å (each level into the map "
-                      "blurred as that level sees it)",
-              "seen_at": lambda level: level_resolution(model, segments, level, args.resolution)}
+                      "blurred as that level sees it)"}
     return result, report, "cc", lambda: target.correlation(model.coords[rows])
 
 

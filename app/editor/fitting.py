@@ -27,7 +27,7 @@ from app.editor.document import Document
 from app.editor.scene.overlay import Compared, chain_segments
 from core.fitting.coarse_to_fine import LevelFit, fit_levels
 from core.fitting.conformation import SAME_FOLD, fold_similarity, pair_segments
-from core.fitting.density import MapTarget, fit_map_levels, heavy_atoms, level_resolution, refine
+from core.fitting.density import MapTarget, fit_map_levels, heavy_atoms, refine
 from core.fitting.settle import settle
 from core.protein.model import Edit
 from core.surfaces.volume import DensityMap
@@ -63,12 +63,9 @@ def map_target(document: Document, density: DensityMap, resolution: float) -> Fi
     :class:`core.surfaces.volume.MapError` where the map does not overlap the model)."""
     model, segments = document.model, edited_chain(document)
     target = MapTarget(density, resolution, model.coords[heavy_atoms(model)])
-
-    def seen_at(level: int) -> float:
-        return level_resolution(model, segments, level, resolution)
     return FitTarget("map", lambda levels, cancelled: fit_map_levels(model, segments, target, levels,
                                                                        cancelled=cancelled),
-                     lambda fit: f"CC {fit.score:.3f} at {seen_at(fit.level):.3g} Å",
+                     lambda fit: f"CC {fit.score:.3f} at {fit.resolution:.3g} Å",
                      lambda level, cancelled: refine(model, segments, target, level, cancelled=cancelled))
 
 

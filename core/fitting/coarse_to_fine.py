@@ -63,10 +63,12 @@ class LevelFit:
     level : the integer level fitted.
     control_points : unknown control points at that level, over all fitted segments.
     score : after the level, the Cα rmsd of the paired residues to the superposed target
-        (Å), or for a map the correlation of the model's density with it.
+        (Å), or for a map the correlation of the model's density with it as the level saw
+        the map (see ``resolution``).
     seconds : time the level took.
     edits : one edit per fitted segment (already applied to the model), from the state
         before this level to the state after it.
+    resolution : for a map, the resolution the level saw it at (Å); None for a structure.
     """
 
     level: int
@@ -74,6 +76,7 @@ class LevelFit:
     score: float
     seconds: float
     edits: tuple[Edit, ...]
+    resolution: float | None = None
 
 
 @lru_cache(maxsize=64)

@@ -279,7 +279,7 @@ def fit_map_levels(
         for edit in planned:
             model.apply(edit)
         n_points = sum(spline_space(min(level, model.ribbons[s].level)).n_points for s in segments)
-        yield LevelFit(level, n_points, cc, time.perf_counter() - start, tuple(planned))
+        yield LevelFit(level, n_points, cc, time.perf_counter() - start, tuple(planned), at.resolution)
 
 
 def level_resolution(model: EditableModel, segments: Sequence[int], level: int, resolution: float) -> float:
