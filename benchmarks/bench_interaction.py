@@ -3,7 +3,9 @@
 Usage: ``xvfb-run -a python benchmarks/bench_interaction.py [--steps N] [STRUCTURE ...]``
 (default: 1UBQ, 1AYE, 4YVS from tests/data). Each event goes through Qt as the mouse or the
 keyboard sends it (QTest), and the clock stops once the event loop has nothing left to do,
-the render included; a counter on the render window says how many frames each event drew.
+the render included; a counter on the render window says how many frames each event drew,
+and one on the view how many times the window was composed (with the view's OpenGL widget
+in it, every event-loop turn that repaints a widget composes the whole window).
 
 Events: a level-slider step (the Right key on the slider), a pick (a click on a control
 point), a drag step (a mouse move while a control point is held), a release (regularized,
@@ -36,12 +38,15 @@ DEFAULT = ("1UBQ.pdb.gz", "1AYE.pdb.gz", "4YVS.cif.gz")
 
 
 class Frames:
-    """Counts the frames the render window draws and the time spent drawing them."""
+    """Counts the frames the render window draws, the time spent drawing them, and the
+    window's compositions."""
 
     def __init__(self, window: MainWindow) -> None:
         self.count = 0
         self.seconds = 0.0
+        self.compositions = 0
         self._started = 0.0
+        window.plotter.aboutToCompose.connect(self._composed)
         window.plotter.ren_win.AddObserver("StartEvent", lambda *_: self._start())
         window.plotter.ren_win.AddObserver("EndEvent", lambda *_: self._drawn())
 
@@ -51,6 +56,9 @@ class Frames:
     def _drawn(self) -> None:
         self.count += 1
         self.seconds += time.perf_counter() - self._started
+
+    def _composed(self) -> None:
+        self.compositions += 1
 
 
 def _settle(app: QApplication) -> None:
@@ -68,16 +76,18 @@ def _widget_point(window: MainWindow, point: np.ndarray) -> QPoint:
     return QPoint(round(x / scale), round(window.plotter.height() - 1 - y / scale))
 
 
-def _timed(app: QApplication, frames: Frames, send) -> tuple[float, float, int]:  # noqa: ANN001 (a callable)
-    """Milliseconds from ``send()`` to an idle event loop, of them rendering, and the frames drawn."""
-    before, drawing = frames.count, frames.seconds
+def _timed(app: QApplication, frames: Frames, send) -> tuple[float, float, int, int]:  # noqa: ANN001 (a callable)
+    """Milliseconds from ``send()`` to an idle event loop, of them rendering, the frames drawn
+    and the window's compositions."""
+    before, drawing, composed = frames.count, frames.seconds, frames.compositions
     start = time.perf_counter()
     send()
     _settle(app)
-    return 1e3 * (time.perf_counter() - start), 1e3 * (frames.seconds - drawing), frames.count - before
+    return (1e3 * (time.perf_counter() - start), 1e3 * (frames.seconds - drawing), frames.count - before,
+            frames.compositions - composed)
 
 
-def measure(app: QApplication, path: Path, steps: int) -> dict[str, list[tuple[float, float, int]]]:
+def measure(app: QApplication, path: Path, steps: int) -> dict[str, list[tuple[float, float, int, int]]]:
     """Times and frame counts of every kind of event on the structure at ``path``."""
     document = Document()
     document.open(path)
@@ -88,9 +98,9 @@ def measure(app: QApplication, path: Path, steps: int) -> dict[str, list[tuple[f
     _settle(app)
     frames = Frames(window)
     view = window.plotter
-    results: dict[str, list[tuple[float, float, int]]] = {}
+    results: dict[str, list[tuple[float, float, int, int]]] = {}
 
-    def record(kind: str, sample: tuple[float, float, int]) -> None:
+    def record(kind: str, sample: tuple[float, float, int, int]) -> None:
         results.setdefault(kind, []).append(sample)
 
     slider = window.dimension_panel.slider
@@ -143,14 +153,15 @@ def main() -> None:
     args = parser.parse_args()
     app = QApplication.instance() or QApplication(sys.argv[:1])
     QSettings.setPath(QSettings.Format.NativeFormat, QSettings.Scope.UserScope, tempfile.mkdtemp())  # not the user's
-    print(f"{'structure':<12} {'event':<12} {'median ms':>10} {'p90 ms':>8} {'render ms':>10} {'frames/event':>13}")
+    print(f"{'structure':<12} {'event':<12} {'median ms':>10} {'p90 ms':>8} {'render ms':>10} {'frames/event':>13} "
+          f"{'compositions/event':>19}")
     for name in args.structures:
         path = Path(name) if Path(name).exists() else DATA / name
         results = measure(app, path, args.steps)
         for kind, samples in results.items():
-            times, drawing, counts = np.array(samples).T
+            times, drawing, counts, compositions = np.array(samples).T
             print(f"{path.name.split('.')[0]:<12} {kind:<12} {np.median(times):>10.1f} {np.percentile(times, 90):>8.1f} "
-                  f"{np.median(drawing):>10.1f} {np.mean(counts):>13.2f}")
+                  f"{np.median(drawing):>10.1f} {np.mean(counts):>13.2f} {np.mean(compositions):>19.2f}")
         moving, rest = (np.median(np.array(results[kind])[:, 1]) for kind in ("rotate step", "at rest"))
         print(f"{path.name.split('.')[0]:<12} frames in motion {rest / moving:.1f}x cheaper than at rest")
 

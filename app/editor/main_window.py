@@ -49,6 +49,7 @@ from PySide6.QtWidgets import (
 
 from app import EXAMPLES_DIR
 from app.editor import help
+from app.editor.composition import compose_once
 from app.editor.docks.comparison import ComparisonPanel
 from app.editor.docks.console import PythonConsole
 from app.editor.docks.map_panel import MapPanel
@@ -98,6 +99,7 @@ class MainWindow(QMainWindow):
 
     def __init__(self, document: Document | None = None, parent: QWidget | None = None) -> None:
         super().__init__(parent)
+        compose_once(self)
         self.document = document if document is not None else Document()
         self.document.setParent(self)
         self.settings = QSettings(APP_NAME, APP_NAME)

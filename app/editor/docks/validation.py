@@ -178,9 +178,9 @@ class ValidationPanel(QWidget):
 
     def _fill_list(self) -> None:
         """Fill the list; where its rows are as many as before (as in most drag steps), only the
-        texts that changed change and the columns only widen: nothing is laid out again, so the
-        list repaints with the frame rather than in an event-loop turn of its own (each composes
-        the whole window)."""
+        texts that changed change. The columns only widen, where a text needs it: a column
+        resized repaints in an event-loop turn of its own, after the frame's, and each turn
+        composes the whole window again."""
         triaged = self.validation.triaged
         if triaged is None:
             return
@@ -205,8 +205,8 @@ class ValidationPanel(QWidget):
                 item.setText(column, text)  # no change where the text is the same
                 item.setFont(column, font)
             item.setTextAlignment(0, Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-        for column in range(len(COLUMNS)):  # to the texts when refilled, else only wider where a text needs it
-            if refilled or tree.sizeHintForColumn(column) > tree.columnWidth(column):
+        for column in range(len(COLUMNS)):
+            if tree.sizeHintForColumn(column) > tree.columnWidth(column):
                 tree.resizeColumnToContents(column)
 
     def _set_kinds(self) -> None:

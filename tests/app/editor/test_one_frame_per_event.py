@@ -73,7 +73,8 @@ def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, op
                                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     """Each event-loop turn that changes a widget composes the whole window once more: a drag
     step checks the moved residues itself once the interval is over, and the list of flags
-    changes its texts in place, so the dock changes in the step's one composition."""
+    changes its texts in place, so the dock changes in the step's one composition. The
+    release, whose regularization refills the list and lays out the docks, composes once too."""
     window = open_window("1UBQ.pdb.gz")
     view, document, tree = window.plotter, window.document, window.validation_panel.offenders
     compositions = []
@@ -99,8 +100,15 @@ def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, op
     assert window.validation.pending
     qtbot.waitUntil(lambda: not window.validation.pending, timeout=5000)  # the drag paused: checked
     assert window.validation.late
+    qtbot.wait(STILL_AFTER_MS + 100)
+    rows = tree.topLevelItemCount()
+    compositions.clear()
     qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=at + QPoint(50, 35))
+    qtbot.wait(STILL_AFTER_MS // 2)
     assert document.undo_stack.count() == 1
+    assert tree.topLevelItemCount() != rows  # the regularization fixed what the drag broke: the list refilled
+    # no column resized, the docks and the main window laid out before the paint, no dock animated: one composition
+    assert len(compositions) == 1
 
 
 def test_a_screenshot_shows_a_change_not_drawn_yet(open_window: Opener) -> None:
