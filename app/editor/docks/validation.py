@@ -192,8 +192,7 @@ class ValidationPanel(QWidget):
             rows.append((["", "", f"… and {more} more", ""], False))
         self.shown.setText(f"{len(triaged.flags)} of {len(self.validation.report.flags)} shown")
         tree = self.offenders
-        refilled = tree.topLevelItemCount() != len(rows)
-        if refilled:
+        if tree.topLevelItemCount() != len(rows):
             tree.clear()
             tree.addTopLevelItems([QTreeWidgetItem(len(COLUMNS)) for _ in rows])
             tree.doItemsLayout()

@@ -24,13 +24,19 @@ def adk() -> EditableModel:
     return EditableModel(read_structure(DATA / "1AKE_adk_closed.pdb.gz"))
 
 
-def _own_map(model: EditableModel, resolution: float = RESOLUTION, around: EditableModel | None = None) -> MapTarget:
-    """The model's own heavy atoms at ``resolution`` Å, on a 1 Å grid, around the heavy atoms
-    of ``around`` (the model itself by default)."""
+def _atoms_on_grid(model: EditableModel) -> tuple[np.ndarray, np.ndarray]:
+    """The model's heavy atoms counted on a 1 Å grid with 12 Å around them, and its origin."""
     coords = model.coords[heavy_atoms(model)]
     origin = np.floor(coords.min(axis=0)) - 12.0
     grid = np.zeros(tuple(int(n) for n in np.ceil(coords.max(axis=0) + 12.0 - origin)))
     np.add.at(grid, tuple(np.round(coords - origin).astype(int).T), 1.0)
+    return grid, origin
+
+
+def _own_map(model: EditableModel, resolution: float = RESOLUTION, around: EditableModel | None = None) -> MapTarget:
+    """The model's own heavy atoms at ``resolution`` Å, on a 1 Å grid, around the heavy atoms
+    of ``around`` (the model itself by default)."""
+    grid, origin = _atoms_on_grid(model)
     density = DensityMap(ndimage.gaussian_filter(grid, gaussian_sigma(resolution)), origin, np.eye(3))
     around = model if around is None else around
     return MapTarget(density, resolution, around.coords[heavy_atoms(around)])
@@ -66,15 +72,12 @@ def test_a_fit_into_a_map_cut_sharply_in_fourier_space_is_not_held_by_its_ripple
     its ripples held the LID domain 5 Å short (3.5 Å overall) while the finest levels saw
     the map at 10 Å; at 12 Å they do not."""
     start = EditableModel(read_structure(DATA / "4AKE_adk_open.pdb.gz"))
-    coords = adk.coords[heavy_atoms(adk)]
-    origin = np.floor(coords.min(axis=0)) - 12.0
-    shape = tuple(int(n) for n in np.ceil(coords.max(axis=0) + 12.0 - origin))
-    grid = np.zeros(shape)
-    np.add.at(grid, tuple(np.round(coords - origin).astype(int).T), 1.0)
+    grid, origin = _atoms_on_grid(adk)
     spectrum = np.fft.rfftn(grid)
-    frequency = np.meshgrid(*(np.fft.fftfreq(n) for n in shape[:2]), np.fft.rfftfreq(shape[2]), indexing="ij")
+    frequency = np.meshgrid(*(np.fft.fftfreq(n) for n in grid.shape[:2]), np.fft.rfftfreq(grid.shape[2]),
+                            indexing="ij")
     spectrum[np.sqrt(sum(f**2 for f in frequency)) > 1.0 / 10.0] = 0.0
-    density = DensityMap(np.fft.irfftn(spectrum, shape, axes=(0, 1, 2)), origin, np.eye(3))
+    density = DensityMap(np.fft.irfftn(spectrum, grid.shape, axes=(0, 1, 2)), origin, np.eye(3))
     target = MapTarget(density, 10.0, start.coords[heavy_atoms(start)])
     fit_map(start, [0], target, range(0, 7))
     ca = start.structure.atoms.name == "CA"
