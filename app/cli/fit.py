@@ -108,7 +108,7 @@ def run_fit(args: argparse.Namespace) -> int:
         print(f"  levels {', '.join(map(str, result.dropped))} undone: the regularized model kept more bad peptide "
               "junctions than the input (the target's backbone differs at that detail)")
     if result.refinement:
-        print(f"  refined: the side chains turned into the map, level {result.levels[-1].level} fitted again with them")
+        print("  refined: every residue moved into the map on its own, its side chains turning, and regularized")
     done = "regularized" if args.regularize else "not regularized"
     changes = ", ".join(f"{before[k]} -> {after[k]} {label}" for k, label in CHECKED)
     print(f"{done}: {name} {final:.3f}{unit}; {changes}")

@@ -9,8 +9,8 @@ step as soon as the level is done, so the view follows the fit. After coarse to 
 fit settles as on the command line (:func:`core.fitting.settle.settle`): the residues that
 moved are regularized as after a drag, one more step, and where that leaves more bad
 peptide junctions than the file had, the finest level's step is undone and the rest
-regularized again. A map fit is then refined (:func:`core.fitting.density.refine`: the side
-chains turned into the map, the finest level fitted again), one more step. Cancel undoes
+regularized again. A map fit is then refined (:func:`core.fitting.density.refine`: every
+residue moved into the map on its own, its side chains turning), one more step. Cancel undoes
 the level under way and keeps the steps done.
 """
 
@@ -34,8 +34,8 @@ from core.surfaces.volume import DensityMap
 
 Fits = Callable[[Sequence[int], Callable[[], bool]], Iterator[LevelFit]]
 """Fits the edited chain at the given levels, asking the callable whether to stop."""
-Refines = Callable[[int, Callable[[], bool]], list[Edit]]
-"""Refines a settled fit whose finest level is the given one: the edits, applied."""
+Refines = Callable[[Callable[[], bool]], list[Edit]]
+"""Refines a settled fit: the edits, applied."""
 
 
 @dataclass(frozen=True)
@@ -48,7 +48,7 @@ class FitTarget:
     score: Callable[[LevelFit], str]
     """A level's score for people: ``'CC 0.953 at 13 Å'`` (the map as that level sees it), ``'Cα rmsd 1.21 Å'``."""
     refine: Refines | None = None
-    """For a map: the side chains turned into it and the finest level fitted again."""
+    """For a map: every residue moved into it on its own, its side chains turning."""
 
 
 def edited_chain(document: Document) -> list[int]:
@@ -66,7 +66,7 @@ def map_target(document: Document, density: DensityMap, resolution: float) -> Fi
     return FitTarget("map", lambda levels, cancelled: fit_map_levels(model, segments, target, levels,
                                                                        cancelled=cancelled),
                      lambda fit: f"CC {fit.score:.3f} at {fit.resolution:.3g} Å",
-                     lambda level, cancelled: refine(model, segments, target, level, cancelled=cancelled))
+                     lambda cancelled: refine(model, segments, target, cancelled=cancelled))
 
 
 def compared_target(document: Document, compared: Compared) -> FitTarget:
@@ -145,9 +145,8 @@ def _settle(document: Document, target: FitTarget, fits: list[LevelFit], progres
     if result.regularization:
         document.push_applied(result.regularization, f"Regularize the fit to {target.name}{undone}")
     if target.refine is not None and result.levels and not progress.wasCanceled():
-        progress.setLabelText(f"Turning the side chains into the {target.name}…")
-        refined = target.refine(result.levels[-1].level, cancelled)
+        progress.setLabelText(f"Refining each residue into the {target.name}…")
+        refined = target.refine(cancelled)
         if refined:
-            document.push_applied(refined, f"Refine the fit to {target.name} (side chains, level "
-                                           f"{result.levels[-1].level} again)")
+            document.push_applied(refined, f"Refine the fit to {target.name} (each residue, side chains)")
     return result.levels

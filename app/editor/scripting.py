@@ -126,7 +126,7 @@ class EditorAPI:
         (an integer), at each of ``levels`` in turn, or (None) coarse to fine from level 0 up to
         the one shown; each level one undo step, and a fit of more than one level settled as
         on the command line (regularized, the finest levels that leave bad junctions undone)
-        and refined (side chains), a step each. ``resolution`` (Å) sets the map's resolution
+        and refined (each residue and its side chains), a step each. ``resolution`` (Å) sets the map's resolution
         first. Returns each level kept and the correlation after it."""
         if resolution is not None:
             self._window.correlation.set_resolution(float(resolution))

@@ -28,10 +28,13 @@ LID domain 5 Å short, at 12 Å the Gaussian smooths them out (3.5 → 1.7 Å). 
 refinement sees the map as it is.
 
 After the levels and the regularization (:func:`~core.fitting.settle.settle`), the fit is
-refined (:func:`refine`): the side chains turn into the map
-(:func:`core.fitting.side_chains.fit_side_chains`), and the finest level is fitted again
-with them and regularized, twice: the regularization, which costs the correlation a little
-each time, costs less as the model settles.
+refined (:func:`refine`): every residue moves into the map on its own as a rigid body, its
+side chains turning (:mod:`core.fitting.real_space`), and is regularized, twice: the
+regularization, which costs the correlation a little each time, costs less as the model
+settles. At the finest level a control point still carries about three residues and
+each residue keeps its rotamer; adenylate kinase into a 6 Å map, open into closed, ended
+at CC 0.957 and 1.47 Å with the side chains turned and the finest level fitted again, and
+at CC 0.985 and 0.66 Å refined residue by residue.
 """
 
 from __future__ import annotations
@@ -46,8 +49,9 @@ from scipy.spatial import cKDTree
 
 from core.curves.splines import spline_space
 from core.fitting.coarse_to_fine import LevelFit, pushed_to_finest
-from core.fitting.settle import FitResult, regularize_fit, settle
-from core.fitting.side_chains import fit_side_chains
+from core.fitting.real_space import refine_real_space
+from core.fitting.settle import FIT_ITERATIONS, FitResult, settle
+from core.geometry.regularize import regularize_region
 from core.protein.model import Edit, EditableModel, per_segment
 from core.protein.structure import ca_rows
 from core.surfaces.volume import DensityMap, MapError
@@ -64,7 +68,12 @@ STIFFNESS = 0.01
 ELASTIC_CUTOFF = 10.0
 """Å: Cα closer than this at the start are joined by springs."""
 REFINE_CYCLES = 2
-"""Rounds of :func:`refine`: the finest level fitted again with the side chains turned."""
+"""Rounds of :func:`refine`: each residue moved into the map, then regularized."""
+REFINE_STIFFNESS = 0.01
+"""CC per Å² of the Cα network's mean squared change in :func:`refine` (as the levels'
+:data:`STIFFNESS`): a residue follows the map only as far as its neighbours let it, or a
+homologue's residues follow another protein's density (1RX4 into 3NZD at 10 Å: 3.64 Å
+without it, 2.96 with it; 0.1 costs adenylate kinase 0.015 of its CC at 6 Å)."""
 GIVE_WAY = 6.0
 """Å: the change of length past which the springs of the yielding network give way."""
 LEVELS_RESOLUTION = 12.0
@@ -366,7 +375,7 @@ def fit_map(
     result = settle(model, fits, regularize=regularize, cancelled=cancelled)
     if not result.levels:
         return result
-    refined = refine(model, segments, target, result.levels[-1].level, regularize=regularize, cancelled=cancelled)
+    refined = refine(model, segments, target, regularize=regularize, cancelled=cancelled)
     return replace(result, refinement=refined)
 
 
@@ -374,34 +383,38 @@ def refine(
     model: EditableModel,
     segments: Sequence[int],
     target: MapTarget,
-    level: int,
     *,
     cycles: int = REFINE_CYCLES,
+    stiffness: float = REFINE_STIFFNESS,
     regularize: bool = True,
     cancelled: Callable[[], bool] = lambda: False,
 ) -> list[Edit]:
-    """After the levels: turn the side chains into the map
-    (:func:`~core.fitting.side_chains.fit_side_chains`), then ``cycles`` times fit ``level``
-    again with them, regularize what that moved and turn the side chains again (the backbone
-    settles into the map as the side chains do, and the regularization costs less each time).
-    Returns the edits, applied, one per segment."""
+    """After the levels: ``cycles`` times, move every residue into the map on its own, its
+    side chains turning (:func:`~core.fitting.real_space.refine_real_space`), the CC less
+    ``stiffness`` times the energy of an elastic network of the Cα as they are now, then
+    regularize what moved (the junctions it held softly close; each cycle costs the
+    correlation less as the model settles). Returns the edits, applied, one per segment."""
     correlation = atom_correlation(model, target)
+    ca = ca_rows(model.structure)[np.concatenate([model.segments[s].residue_index for s in segments])]
+    network = ElasticNetwork(model.coords[ca])
+
+    def restrained(coords: np.ndarray) -> tuple[float, np.ndarray]:
+        cc, gradient = correlation(coords)
+        energy, pull = network.gradient(coords[ca])
+        gradient[ca] -= stiffness * pull
+        return cc - stiffness * energy, gradient
+
     done: list[Edit] = []
-
-    def turn_side_chains() -> None:
-        turned = fit_side_chains(model, segments, correlation, cancelled=cancelled)
-        for edit in turned:
-            model.apply(edit)
-        done.extend(turned)
-
-    turn_side_chains()
     for _ in range(cycles):
         if cancelled():
             break
-        again = list(fit_map_levels(model, segments, target, [level], give_way=None, blurred=False,
-                                    cancelled=cancelled))
-        done.extend(edit for fit in again for edit in fit.edits)
-        if regularize:
-            done.extend(regularize_fit(model, again))
-        turn_side_chains()
+        moved = refine_real_space(model, segments, restrained, cancelled=cancelled)
+        for edit in moved:
+            model.apply(edit)
+        done.extend(moved)
+        if regularize and not cancelled():
+            for edit in moved:
+                step = regularize_region(model, edit.segment, edit.residues, max_iterations=FIT_ITERATIONS)
+                model.apply(step)
+                done.append(step)
     return per_segment(done)

@@ -1,29 +1,25 @@
-"""Side chains turned into a density map: the χ torsions refined against the map.
+"""Side-chain torsions and overlaps, for refinement into a map (:mod:`core.fitting.real_space`).
 
-After the backbone levels, a map at finer resolutions shows where the side chains lie,
-and a model that keeps its own rotamers cannot match it. Here each side chain's χ1 … χ4
-(the IUPAC bonds of :data:`CHI_BONDS`) turn together, by L-BFGS with bounds, to raise the
-correlation, each torsion turning the atoms beyond its bond. The gradient is analytic: for
-a turn about the unit axis ``a`` through ``p``, an atom at ``x`` moves by ``a × (x − p)``
-per radian, so ``∂E/∂χ = Σ (a × (x − p)) · ∂E/∂x`` over the atoms beyond the bond. The
-turns stay within :data:`MAX_TURN` of the start, and a one-sided penalty keeps turned atoms
-from overlapping others by more than they did at the start (or than
-:data:`~core.geometry.clash_list.CLASH_TARGET`). Residues with alternate conformers keep
-their side chains.
+:class:`Rotors` are the χ1 … χ4 of the side chains (the IUPAC bonds of :data:`CHI_BONDS`),
+each turning the atoms beyond its bond, with the analytic gradient: for a turn about the
+unit axis ``a`` through ``p``, an atom at ``x`` moves by ``a × (x − p)`` per radian, so
+``∂E/∂χ = Σ (a × (x − p)) · ∂E/∂x`` over the atoms beyond the bond. :class:`Clashes` is a
+one-sided penalty that keeps moved atoms from overlapping others by more than they did at
+the start (or than :data:`~core.geometry.clash_list.CLASH_TARGET`). Residues with alternate
+conformers keep their side chains.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import optimize
 
 from core.geometry.clash_list import CLASH_TARGET
 from core.geometry.topology import topology
 from core.geometry.vectors import distance, unit
-from core.protein.model import Edit, EditableModel
+from core.protein.model import EditableModel
 
 CHI_BONDS = {
     "ARG": (("CA", "CB"), ("CB", "CG"), ("CG", "CD"), ("CD", "NE")),
@@ -47,11 +43,8 @@ CHI_BONDS = {
 """The bond of each side-chain torsion χ1, χ2, … (the middle two atoms of its IUPAC definition)."""
 REMOTE = "ABGDEZH"
 """The remoteness letters of side-chain atom names, from Cα outward."""
-MAX_TURN = np.radians(60.0)
-"""Most a torsion turns from the start."""
 CLASH_WEIGHT = 0.01
 """CC per Å² of overlap beyond what is allowed, summed over pairs."""
-ITERATIONS = 100
 
 
 @dataclass(frozen=True)
@@ -125,58 +118,7 @@ def side_chain_rotors(model: EditableModel, segments: Sequence[int]) -> Rotors:
     return Rotors(np.array(bonds), np.array(depth), np.concatenate(atoms), np.concatenate(owner))
 
 
-def fit_side_chains(
-    model: EditableModel,
-    segments: Sequence[int],
-    score: Callable[[np.ndarray], tuple[float, np.ndarray]],
-    *,
-    cancelled: Callable[[], bool] = lambda: False,
-) -> list[Edit]:
-    """Turn the side chains of ``segments`` to raise ``score`` (of all the model's
-    coordinates: the value and its gradient (n, 3), as a map's correlation; see the
-    module); returns one edit per segment whose side chains turned (not applied)."""
-    rotors = side_chain_rotors(model, segments)
-    if not len(rotors.bonds) or cancelled():
-        return []
-    start = model.coords.copy()
-    clashes = _Clashes(model, np.unique(rotors.atoms))
-
-    best = {"value": np.inf, "angles": np.zeros(len(rotors.bonds))}
-
-    def negative(angles: np.ndarray) -> tuple[float, np.ndarray]:
-        if cancelled():
-            raise _Cancelled
-        coords = rotors.turned(start, angles)
-        value, per_atom = score(coords)
-        penalty, push = clashes.penalty(coords)
-        objective = -(value - CLASH_WEIGHT * penalty)
-        if objective < best["value"]:
-            best.update(value=objective, angles=angles.copy())
-        return objective, -rotors.gradient(coords, per_atom - CLASH_WEIGHT * push)
-
-    try:
-        optimize.minimize(negative, best["angles"], jac=True, method="L-BFGS-B",
-                          bounds=[(-MAX_TURN, MAX_TURN)] * len(rotors.bonds), options={"maxiter": ITERATIONS})
-    except _Cancelled:
-        pass
-    coords = rotors.turned(start, best["angles"])
-    edits = []
-    for s in segments:
-        segment = model.segments[s]
-        residues = np.flatnonzero([np.any(coords[a:b] != start[a:b]) for a, b in zip(segment.atom_start,
-                                                                                      segment.atom_stop)])
-        if len(residues):
-            moved = np.concatenate([np.arange(segment.atom_start[r], segment.atom_stop[r]) for r in residues])
-            points = model.ribbons[s].points
-            edits.append(Edit(s, points, points, residues, moved, start[moved], coords[moved]))
-    return edits
-
-
-class _Cancelled(Exception):
-    """Raised inside the optimiser to stop it."""
-
-
-class _Clashes:
+class Clashes:
     """A one-sided penalty on the overlap of the pairs with an atom of ``rows`` that come
     within reach of clashing: each may overlap by CLASH_TARGET, or by what it did at the start."""
 

@@ -102,12 +102,13 @@ def regularized(model: EditableModel, edit: Edit, *, flank: int = FLANK, max_ite
 
 
 def regularize_region(
-    model: EditableModel, segment: int, residues: object, *, flank: int = 0, reference: np.ndarray | None = None
+    model: EditableModel, segment: int, residues: object, *, flank: int = 0, reference: np.ndarray | None = None,
+    max_iterations: int = MAX_ITERATIONS,
 ) -> Edit:
     """The edit that regularizes ``residues`` (indices within ``segment``) and up to
     ``flank`` neighbours on each side of the current model, tethered to its current curve
     (control points unchanged). Pairs may keep the overlap they had in ``reference``
-    (default: the structure as read)."""
+    (default: the structure as read); ``max_iterations`` Levenberg–Marquardt steps at most."""
     ribbon = model.ribbons[segment]
     n_residues = len(model.segments[segment])
     residues = np.asarray(residues, dtype=np.int64)
@@ -119,7 +120,7 @@ def regularize_region(
     tangents = ribbon.space.evaluate(ribbon.points, u, 1)
     reference = model.structure.coords if reference is None else reference
     result = relax(model.structure, model.coords, model.segments[segment].residue_index[free], anchors, tangents,
-                   reference)
+                   reference, max_iterations=max_iterations)
     return Edit(segment, ribbon.points, ribbon.points, free, result.rows, model.coords[result.rows], result.coords)
 
 

@@ -135,7 +135,7 @@ class Restraints:
         first, second = top.first[k], top.second[k]
         full = (bb[first, 1:4] >= 0).all(axis=1) & (bb[second, :2] >= 0).all(axis=1)
         before, after = first[full], second[full]
-        ideal_n, ideal_ca = _ideal_next(coords, bb[before], bb[after], top.cis[k[full]], top.proline[k[full]])
+        ideal_n, ideal_ca = ideal_next(coords, bb[before], bb[after], top.cis[k[full]], top.proline[k[full]])
         stiff = np.eye(3) / JUNCTION_SIGMA
         coincide((ideal_n, body_of[before], PSI), (coords[bb[after, 0]], body_of[after]), stiff)
         coincide((ideal_ca, body_of[before], PSI), (coords[bb[after, 1]], body_of[after]), stiff)
@@ -334,7 +334,7 @@ def _normal_planes(along: np.ndarray) -> np.ndarray:
     return np.stack([first, cross(along, first)], axis=1)
 
 
-def _ideal_next(
+def ideal_next(
     coords: np.ndarray, here: np.ndarray, after: np.ndarray, cis: np.ndarray, proline: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Ideal N and Cα of the residue after each junction, from this residue's Cα, C, O.

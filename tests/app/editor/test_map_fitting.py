@@ -175,7 +175,7 @@ def test_fit_to_map_coarse_to_fine_is_one_step_a_level_and_a_regularization(wind
     steps, index = window.rw.history()
     assert index == 6 and [s.split(" (")[0] for s in steps[:4]] == [f"Fit to map at level {k}" for k in range(4)]
     assert steps[4] == "Regularize the fit to map"
-    assert steps[5] == "Refine the fit to map (side chains, level 3 again)"
+    assert steps[5] == "Refine the fit to map (each residue, side chains)"
     assert window.rw.map_correlation > cc + 0.1
     assert _ca_rmsd(window, target_ca) < rmsd - 2.0  # towards the open form whose map it is
     window.rw.undo()  # the refinement: the side chains turned back, the backbone as regularized

@@ -1,14 +1,15 @@
-"""Fitting into density maps (#19): the map blurred for the levels; side chains turned into it
-(χ rotors, their analytic gradient, the fit)."""
+"""Fitting into density maps (#19): the map blurred for the levels; the refinement, every
+residue a rigid body with its side chains' χ rotors (their analytic gradients, the fit)."""
 
 from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy import ndimage
+from scipy import ndimage, sparse
 
-from core.fitting.density import MapTarget, atom_correlation, fit_map, gaussian_sigma, heavy_atoms
-from core.fitting.side_chains import fit_side_chains, side_chain_rotors
+from core.fitting.density import MapTarget, atom_correlation, fit_map, gaussian_sigma, heavy_atoms, refine
+from core.fitting.real_space import ResidueBodies
+from core.fitting.side_chains import side_chain_rotors
 from core.geometry.topology import topology
 from core.geometry.validation import validate
 from core.protein.model import EditableModel
@@ -115,19 +116,59 @@ def test_the_gradient_is_the_derivative_of_the_correlation(adk: EditableModel) -
         assert numeric == pytest.approx(gradient[k], rel=0.1)
 
 
-def test_side_chains_turned_away_turn_back_into_their_map_without_new_clashes(adk: EditableModel) -> None:
+def test_the_real_space_gradient_is_the_derivative_of_what_it_climbs(adk: EditableModel) -> None:
+    """Shifts, rotations (through the right Jacobian of SO(3)) and torsions, at a state far
+    from the start, for a function of the atoms (the CC) and of the ideal junction points."""
+    bodies = ResidueBodies(adk, [0])
+    correlation = atom_correlation(adk, _own_map(adk))
+    pull = np.random.default_rng(5).normal(size=bodies.ideal.shape)
+
+    def value(x: np.ndarray) -> float:
+        coords, ideal, _ = bodies.place(x)
+        return correlation(coords)[0] + 1e-3 * np.sum(pull * ideal)
+
+    x = np.random.default_rng(6).normal(0.0, 0.5, bodies.size)
+    coords, _, placed = bodies.place(x)
+    gradient = bodies.gradient(correlation(coords)[1], 1e-3 * pull, placed)
+    n = bodies.n
+    for part in (slice(0, 3 * n), slice(3 * n, 6 * n), slice(6 * n, None)):
+        direction = np.zeros(bodies.size)
+        direction[part] = np.random.default_rng(7).normal(size=direction[part].shape)
+        numeric = (value(x + 1e-5 * direction) - value(x - 1e-5 * direction)) / 2e-5
+        assert numeric == pytest.approx(gradient @ direction, rel=1e-3)
+
+
+def test_residues_moved_off_their_map_refine_back_into_it_each_as_it_was(adk: EditableModel) -> None:
+    """Every residue of 1AKE shifted, turned and its side chains turned away from its own 6 Å
+    map: the refinement brings them back, each residue exactly its shape, junctions closed."""
     model = EditableModel(adk.structure)
     target = _own_map(model)
-    rotors = side_chain_rotors(model, [0])
-    model.coords = rotors.turned(model.coords, np.random.default_rng(3).uniform(-0.8, 0.8, len(rotors.bonds)))
-    rows = heavy_atoms(model)
-    cc, clashes = target.correlation(model.coords[rows]), validate(model.structure, model.coords).counts["clash"]
-    start = model.coords.copy()
-    edits = fit_side_chains(model, [0], atom_correlation(model, target))
-    assert len(edits) == 1 and np.array_equal(edits[0].old_points, edits[0].new_points)  # the backbone stays
-    for edit in edits:
-        model.apply(edit)
-    assert target.correlation(model.coords[rows]) > cc + 0.015 and target.correlation(model.coords[rows]) > 0.99
-    assert validate(model.structure, model.coords).counts["clash"] <= clashes
-    main_chain = np.isin(model.structure.atoms.name, ("N", "CA", "C", "O", "CB"))
-    assert np.array_equal(model.coords[main_chain], start[main_chain])
+    bodies = ResidueBodies(model, [0])
+    rng = np.random.default_rng(3)
+    n = bodies.n
+    away = np.concatenate([rng.normal(0.0, 0.4, 3 * n), rng.normal(0.0, 0.4, 3 * n),
+                           rng.uniform(-2.0, 2.0, bodies.size - 6 * n)])  # about 0.7 Å, 13°; χ ±38°
+    model.coords = bodies.place(away)[0]
+    rows, ca = heavy_atoms(model), model.structure.atoms.name == "CA"
+    moved = target.correlation(model.coords[rows])
+
+    def rmsd() -> float:
+        return float(np.sqrt(np.mean(np.sum((model.coords[ca] - adk.coords[ca]) ** 2, axis=1))))
+
+    off = rmsd()
+    edits = refine(model, [0], target, cycles=1)
+    assert edits and all(np.array_equal(e.old_points, e.new_points) for e in edits)  # the curve stays
+    assert moved < 0.97 and target.correlation(model.coords[rows]) > 0.99
+    assert rmsd() < off / 2
+    counts = validate(model.structure, model.coords).counts
+    read = validate(model.structure, adk.coords).counts
+    assert counts["peptide_bond"] == 0 and counts["clash"] <= read["clash"]
+    top = topology(model.structure)
+    i, j = np.divmod(top.excluded, top.n_atoms)
+    bonded = np.linalg.norm(adk.coords[i] - adk.coords[j], axis=1) < 1.9
+    i, j = i[bonded], j[bonded]
+    bonds = sparse.coo_matrix((np.ones(len(i)), (i, j)), shape=(top.n_atoms,) * 2)
+    i, j = sparse.triu((bonds + bonds.T) + (bonds + bonds.T) @ (bonds + bonds.T), k=1).nonzero()  # bonds, angles
+    same = model.structure.atom_residue[i] == model.structure.atom_residue[j]
+    before, after = (np.linalg.norm(c[i[same]] - c[j[same]], axis=1) for c in (adk.coords, model.coords))
+    assert len(before) > len(rows) and np.abs(after - before).max() < 1e-9  # no residue changes shape
