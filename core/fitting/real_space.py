@@ -69,6 +69,7 @@ class ResidueBodies:
         ideal_n, ideal_ca = ideal_next(self.start, backbone[first], backbone[second], top.cis[k], top.proline[k])
         self.ideal = np.concatenate([ideal_n, ideal_ca])
         self.ideal_owner = np.concatenate([body_of[first], body_of[first]])
+        self.ideal_arm = self.ideal - self.centre[self.ideal_owner]
         self.ideal_on = np.concatenate([backbone[second, 0], backbone[second, 1]])  # the atoms that sit there
         self.size = 6 * self.n + len(self.rotors.bonds)
 
@@ -82,14 +83,14 @@ class ResidueBodies:
         arm = turned[self.rows] - self.centre[self.owner]
         coords = self.start.copy()
         coords[self.rows] = self.centre[self.owner] + shift[self.owner] + _apply(matrices[self.owner], arm)
-        ideal_arm = self.ideal - self.centre[self.ideal_owner]
-        ideal = self.centre[self.ideal_owner] + shift[self.ideal_owner] + _apply(matrices[self.ideal_owner], ideal_arm)
-        return coords, ideal, (rotation, matrices, turned, arm, ideal_arm)
+        ideal = (self.centre[self.ideal_owner] + shift[self.ideal_owner]
+                 + _apply(matrices[self.ideal_owner], self.ideal_arm))
+        return coords, ideal, (rotation, matrices, turned, arm)
 
     def gradient(self, per_atom: np.ndarray, per_ideal: np.ndarray, placed: tuple) -> np.ndarray:
         """The gradient with respect to the unknowns of a function of the atoms and the
         ideal points whose gradients are ``per_atom`` (n_atoms, 3) and ``per_ideal``."""
-        rotation, matrices, turned, arm, ideal_arm = placed
+        rotation, matrices, turned, arm = placed
         on_body = per_atom[self.rows]
         shift = np.zeros((self.n, 3))
         np.add.at(shift, self.owner, on_body)
@@ -97,7 +98,8 @@ class ResidueBodies:
         local = _apply_transposed(matrices[self.owner], on_body)  # in each body's start frame
         moment = np.zeros((self.n, 3))
         np.add.at(moment, self.owner, cross(arm, local))
-        np.add.at(moment, self.ideal_owner, cross(ideal_arm, _apply_transposed(matrices[self.ideal_owner], per_ideal)))
+        np.add.at(moment, self.ideal_owner,
+                  cross(self.ideal_arm, _apply_transposed(matrices[self.ideal_owner], per_ideal)))
         turn = np.einsum("bji,bj->bi", _right_jacobian(rotation), moment)
         unturned = np.zeros_like(per_atom)
         unturned[self.rows] = local

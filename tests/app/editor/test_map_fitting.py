@@ -178,7 +178,7 @@ def test_fit_to_map_coarse_to_fine_is_one_step_a_level_and_a_regularization(wind
     assert steps[5] == "Refine the fit to map (each residue, side chains)"
     assert window.rw.map_correlation > cc + 0.1
     assert _ca_rmsd(window, target_ca) < rmsd - 2.0  # towards the open form whose map it is
-    window.rw.undo()  # the refinement: the side chains turned back, the backbone as regularized
+    window.rw.undo()  # the refinement: the residues and side chains back, as regularized
     regularized = document.model.coords.copy()
     window.rw.redo()
     side_chain = ~np.isin(document.structure.atoms.name, ("N", "CA", "C", "O", "CB"))
