@@ -1,11 +1,12 @@
 """End to end: a real Qt event sent to a real editor window, timed until its frame is drawn.
 
-Usage: ``xvfb-run -a python benchmarks/bench_interaction.py [--steps N] [STRUCTURE ...]``
-(default: 1UBQ, 1AYE, 4YVS from tests/data). Each event goes through Qt as the mouse or the
+Usage: ``xvfb-run -a python benchmarks/bench_interaction.py [--steps N] [--views KIND ...] [STRUCTURE ...]``
+(default: 1UBQ, 1AYE, 4YVS from tests/data, each in both 3D views: VTK's native window and
+pyvistaqt's OpenGL widget, side by side). Each event goes through Qt as the mouse or the
 keyboard sends it (QTest), and the clock stops once the event loop has nothing left to do,
 the render included; a counter on the render window says how many frames each event drew,
-and one on the view how many times the window was composed (with the view's OpenGL widget
-in it, every event-loop turn that repaints a widget composes the whole window).
+and, in the OpenGL widget, one on the view how many times the window was composed (with
+that widget in it, every event-loop turn that repaints a widget composes the whole window).
 
 Events: a level-slider step (the Right key on the slider), a pick (a click on a control
 point), a drag step (a mouse move while a control point is held), a release (regularized,
@@ -19,6 +20,7 @@ percentiles in ms; "render ms" is the time in VTK's render, the rest is Python a
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import tempfile
 import time
@@ -46,7 +48,8 @@ class Frames:
         self.seconds = 0.0
         self.compositions = 0
         self._started = 0.0
-        window.plotter.aboutToCompose.connect(self._composed)
+        if hasattr(type(window.plotter), "aboutToCompose"):  # the OpenGL widget
+            window.plotter.aboutToCompose.connect(self._composed)
         window.plotter.ren_win.AddObserver("StartEvent", lambda *_: self._start())
         window.plotter.ren_win.AddObserver("EndEvent", lambda *_: self._drawn())
 
@@ -87,8 +90,10 @@ def _timed(app: QApplication, frames: Frames, send) -> tuple[float, float, int, 
             frames.compositions - composed)
 
 
-def measure(app: QApplication, path: Path, steps: int) -> dict[str, list[tuple[float, float, int, int]]]:
-    """Times and frame counts of every kind of event on the structure at ``path``."""
+def measure(app: QApplication, path: Path, steps: int, view_kind: str) -> dict[str, list[tuple[float, float, int, int]]]:
+    """Times and frame counts of every kind of event on the structure at ``path``, in the 3D
+    view ``view_kind``."""
+    os.environ["RIBBONWAVE_VIEW"] = view_kind
     document = Document()
     document.open(path)
     window = MainWindow(document)
@@ -150,20 +155,25 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("structures", nargs="*", default=list(DEFAULT))
     parser.add_argument("--steps", type=int, default=20)
+    parser.add_argument("--views", nargs="+", choices=("native", "widget"), default=["native", "widget"])
     args = parser.parse_args()
     app = QApplication.instance() or QApplication(sys.argv[:1])
     QSettings.setPath(QSettings.Format.NativeFormat, QSettings.Scope.UserScope, tempfile.mkdtemp())  # not the user's
-    print(f"{'structure':<12} {'event':<12} {'median ms':>10} {'p90 ms':>8} {'render ms':>10} {'frames/event':>13} "
-          f"{'compositions/event':>19}")
+    print(f"{'structure':<12} {'view':<7} {'event':<12} {'median ms':>10} {'p90 ms':>8} {'render ms':>10} "
+          f"{'frames/event':>13} {'compositions/event':>19}")
     for name in args.structures:
         path = Path(name) if Path(name).exists() else DATA / name
-        results = measure(app, path, args.steps)
-        for kind, samples in results.items():
-            times, drawing, counts, compositions = np.array(samples).T
-            print(f"{path.name.split('.')[0]:<12} {kind:<12} {np.median(times):>10.1f} {np.percentile(times, 90):>8.1f} "
-                  f"{np.median(drawing):>10.1f} {np.mean(counts):>13.2f} {np.mean(compositions):>19.2f}")
-        moving, rest = (np.median(np.array(results[kind])[:, 1]) for kind in ("rotate step", "at rest"))
-        print(f"{path.name.split('.')[0]:<12} frames in motion {rest / moving:.1f}x cheaper than at rest")
+        entry = path.name.split('.')[0]
+        for view_kind in args.views:
+            results = measure(app, path, args.steps, view_kind)
+            for kind, samples in results.items():
+                times, drawing, counts, compositions = np.array(samples).T
+                composed = f"{np.mean(compositions):.2f}" if view_kind == "widget" else "-"
+                print(f"{entry:<12} {view_kind:<7} {kind:<12} {np.median(times):>10.1f} "
+                      f"{np.percentile(times, 90):>8.1f} {np.median(drawing):>10.1f} {np.mean(counts):>13.2f} "
+                      f"{composed:>19}")
+            moving, rest = (np.median(np.array(results[kind])[:, 1]) for kind in ("rotate step", "at rest"))
+            print(f"{entry:<12} {view_kind:<7} frames in motion {rest / moving:.1f}x cheaper than at rest")
 
 
 if __name__ == "__main__":

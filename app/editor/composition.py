@@ -1,8 +1,10 @@
 """One composition of the window per event.
 
-With a ``QOpenGLWidget`` in it (the 3D view), every event-loop turn that repaints a widget
-composes the whole window again: 15–20 ms with software OpenGL for a 1400 × 900 window. Two
-habits of Qt's own give an event turns of their own after the frame's:
+With a ``QOpenGLWidget`` in it (the 3D view where it is pyvistaqt's widget, see
+:mod:`app.editor.scene.view`), every event-loop turn that repaints a widget composes the whole
+window again: 15–20 ms with software OpenGL for a 1400 × 900 window. Beside VTK's native
+window a turn only repaints the widgets that changed, but each still costs. Two habits of
+Qt's own give an event turns of their own after the frame's:
 
 - A layout request climbs the widget tree one level per turn. A label's new text lays out its
   panel, and the next turns lay out the dock's scroll area, the dock and the main window,

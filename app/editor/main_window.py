@@ -5,8 +5,7 @@ The window wires the pieces together: a :class:`~app.editor.document.Document`, 
 :class:`~app.editor.picking.PointerAdapter` feeding mouse events to the
 :class:`~app.editor.drag.DragController`, and the dock panels. It also owns the file dialogs
 (open, save, recent files, drag-and-drop; image export is :mod:`app.editor.export_image`'s)
-and asks before unsaved edits would be lost. The ``app`` package sets ``QT_API`` before this
-module imports pyvistaqt.
+and asks before unsaved edits would be lost.
 """
 
 from __future__ import annotations
@@ -71,7 +70,7 @@ from app.editor.scene.molecule import Colouring
 from app.editor.scene.overlay import Compared, Comparison, ComparisonView
 from app.editor.scene.scene import Layer, Scene
 from app.editor.scene.validation_markers import ValidationMarkers
-from app.editor.scene.view import View
+from app.editor.scene.view import new_view
 from app.editor.scripting import EditorAPI
 from core.geometry.validation import Flag
 from core.protein.lookup import find_residues
@@ -109,7 +108,7 @@ class MainWindow(QMainWindow):
         """Run by a script: no dialog waits for a person, and unsaved edits stay in the journal."""
         self.journal = journal.Journal(self.document)
 
-        self.plotter = View(self, auto_update=False)
+        self.plotter = new_view(self)
         self.plotter.setAcceptDrops(False)  # dropped files go to the window, which opens them
         self.plotter.iren.clear_key_event_callbacks()  # no pyvista key bindings ('q' would close the view)
         self._swallow_style_keys()

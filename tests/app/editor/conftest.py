@@ -24,6 +24,15 @@ def open_window(qtbot: QtBot) -> Callable[[str], MainWindow]:
         window.show()
         qtbot.waitExposed(window)
         window.plotter.render()
+        qtbot.waitUntil(lambda: window.plotter.frames > 0)
         return window
 
     return open_
+
+
+@pytest.fixture(params=["native", "widget"])
+def view_kind(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
+    """Each of the two 3D views (``RIBBONWAVE_VIEW``): VTK's native window and pyvistaqt's
+    ``QOpenGLWidget``; ask for it before ``open_window``."""
+    monkeypatch.setenv("RIBBONWAVE_VIEW", request.param)
+    return request.param

@@ -13,6 +13,7 @@ from pytestqt.qtbot import QtBot
 from app.editor import live_validation
 from app.editor.live_validation import DRAG_INTERVAL_MS
 from app.editor.main_window import MainWindow
+from app.editor.scene import view as view_module
 from app.editor.scene.scene import STILL_AFTER_MS, Layer
 
 Opener = Callable[[str], MainWindow]
@@ -43,8 +44,9 @@ def _point_of(window: MainWindow, index: int) -> QPoint:
     return QPoint(round(x / view.devicePixelRatioF()), round(view.height() - 1 - y / view.devicePixelRatioF()))
 
 
-def test_each_event_draws_one_frame(qtbot: QtBot, open_window: Opener) -> None:
+def test_each_event_draws_one_frame(qtbot: QtBot, view_kind: str, open_window: Opener) -> None:
     window = open_window("1AYE.pdb.gz")
+    assert type(window.plotter).__name__ == {"native": "NativeView", "widget": "WidgetView"}[view_kind]
     document = window.document
     window.scene.set_layer(Layer.CA_TRACE, True)  # more views to change
     view = window.plotter
@@ -69,9 +71,11 @@ def test_each_event_draws_one_frame(qtbot: QtBot, open_window: Opener) -> None:
     assert view.camera.distance < distance
 
 
-def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, open_window: Opener,
+@pytest.mark.parametrize("view_kind", ["widget"], indirect=True)
+def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, view_kind: str, open_window: Opener,
                                                                 monkeypatch: pytest.MonkeyPatch) -> None:
-    """Each event-loop turn that changes a widget composes the whole window once more: a drag
+    """With the view in a ``QOpenGLWidget``, each event-loop turn that changes a widget
+    composes the whole window once more: a drag
     step checks the moved residues itself once the interval is over, and the list of flags
     changes its texts in place, so the dock changes in the step's one composition. The
     release, whose regularization refills the list and lays out the docks, composes once too."""
@@ -111,12 +115,21 @@ def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, op
     assert len(compositions) == 1
 
 
-def test_a_screenshot_shows_a_change_not_drawn_yet(open_window: Opener) -> None:
+def test_a_screenshot_shows_a_change_not_drawn_yet(view_kind: str, open_window: Opener) -> None:
     window = open_window("1UBQ.pdb.gz")
     before = window.plotter.screenshot(return_img=True).astype(int)
     window.scene.set_layer(Layer.TUBE, False)  # asks for a frame; none is drawn before the loop turns
     after = window.plotter.screenshot(return_img=True).astype(int)
     assert np.count_nonzero(np.abs(after - before).sum(axis=2) > 30) > 5000
+
+
+def test_the_view_is_a_native_window_where_vtk_can_draw_into_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("RIBBONWAVE_VIEW", raising=False)
+    assert QApplication.platformName() == "xcb" and view_module.view_kind() == "native"
+    monkeypatch.setattr(view_module.QGuiApplication, "platformName", staticmethod(lambda: "wayland"))
+    assert view_module.view_kind() == "widget"
+    monkeypatch.setenv("RIBBONWAVE_VIEW", "Native")
+    assert view_module.view_kind() == "native"
 
 
 def test_help_names_the_keys_bound_and_the_versions(qtbot: QtBot) -> None:

@@ -1,6 +1,6 @@
 """Start-up imports what the first window shows only: the surface code, the comparison of
 structures (and numba, which compiles its alignment), matplotlib's Qt canvas and the cluster
-code load when first used
+code load when first used, and pyvistaqt only where the view cannot be a native window
 (``benchmarks/bench_startup.py`` times the start)."""
 
 import json
@@ -15,6 +15,7 @@ DEFERRED = (
     "skimage", "pywt", "dask", "distributed", "scipy.ndimage", "core.surfaces.levelled", "core.surfaces.molecular",
     "core.surfaces.volume", "core.surfaces.globe", "core.analysis.compare", "core.analysis.fold_alignment",
     "core.analysis.tm_align", "numba", "core.fitting", "app.editor.fitting", "matplotlib.backends.backend_qtagg", "app.cli",
+    "pyvistaqt", "qtpy", "app.editor.scene.widget_view",
 )  # fmt: skip
 """Modules (and their submodules) that the first window does without."""
 FIRST_WINDOW = """
