@@ -1,7 +1,7 @@
 """The editor window under Xvfb: the view follows the document, mouse drags edit, files round-trip.
 
 Drags go through the same path as the mouse: events invoked on the VTK interactor of the
-``QtInteractor`` at the display position of a control-point sphere.
+3D view at the display position of a control-point sphere.
 """
 
 import gzip
@@ -618,3 +618,15 @@ def test_the_window_fits_a_small_screen_and_keeps_its_layout(qtbot: QtBot, monke
     again = MainWindow()
     qtbot.addWidget(again)
     assert again.size() == size and again.console_dock.isVisibleTo(again)
+
+
+def test_vtk_one_letter_keys_leave_the_view_alone(qtbot: QtBot, view_kind: str, open_window) -> None:  # noqa: ANN001
+    """'e' and 'q' would close VTK's or pyvista's window, 'w' draw wireframes, '3' stereo."""
+    window = open_window("1UBQ.pdb.gz")
+    view, tube = window.plotter, window.scene.actors["tube"]
+    view.setFocus()
+    for key in "wq3e":
+        qtbot.keyClick(view, key)
+    qtbot.wait(50)
+    assert window.isVisible() and view.isVisible() and not view._closed
+    assert tube.prop.style == "Surface" and not view.ren_win.GetStereoRender()
