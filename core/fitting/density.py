@@ -52,6 +52,7 @@ from core.fitting.coarse_to_fine import LevelFit, pushed_to_finest
 from core.fitting.real_space import refine_real_space
 from core.fitting.settle import FIT_ITERATIONS, FitResult, settle
 from core.geometry.regularize import regularize_region
+from core.geometry.vectors import lengths, pair_gradient
 from core.protein.model import Edit, EditableModel, per_segment
 from core.protein.structure import ca_rows
 from core.surfaces.volume import DensityMap, MapError
@@ -231,7 +232,7 @@ class ElasticNetwork:
     def gradient(self, ca: np.ndarray) -> tuple[float, np.ndarray]:
         """The energy and its gradient (n, 3) with respect to each Cα."""
         vector = ca[self.i] - ca[self.j]
-        length = np.linalg.norm(vector, axis=1)
+        length = lengths(vector)
         stretch = length - self.rest
         n = max(len(stretch), 1)
         if self.give_way is None:
@@ -240,10 +241,7 @@ class ElasticNetwork:
             ratio = (stretch / self.give_way) ** 2
             energy, slope = self.give_way**2 * np.log1p(ratio), 2.0 * stretch / (1.0 + ratio)
         force = (slope / (n * np.maximum(length, 1e-9)))[:, None] * vector
-        gradient = np.zeros_like(ca)
-        np.add.at(gradient, self.i, force)
-        np.add.at(gradient, self.j, -force)
-        return float(np.sum(energy) / n), gradient
+        return float(np.sum(energy) / n), pair_gradient(self.i, self.j, force, len(ca))
 
 
 def fit_map_levels(

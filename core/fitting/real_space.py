@@ -31,7 +31,7 @@ from scipy.spatial.transform import Rotation
 from core.fitting.side_chains import CLASH_WEIGHT, Clashes, side_chain_rotors
 from core.geometry.restraints import ideal_next
 from core.geometry.topology import topology
-from core.geometry.vectors import cross
+from core.geometry.vectors import cross, summed_rows
 from core.protein.model import Edit, EditableModel
 
 JUNCTION_WEIGHT = 0.01
@@ -92,14 +92,11 @@ class ResidueBodies:
         ideal points whose gradients are ``per_atom`` (n_atoms, 3) and ``per_ideal``."""
         rotation, matrices, turned, arm = placed
         on_body = per_atom[self.rows]
-        shift = np.zeros((self.n, 3))
-        np.add.at(shift, self.owner, on_body)
-        np.add.at(shift, self.ideal_owner, per_ideal)
+        owners = np.concatenate([self.owner, self.ideal_owner])
+        shift = summed_rows(owners, np.concatenate([on_body, per_ideal]), self.n)
         local = _apply_transposed(matrices[self.owner], on_body)  # in each body's start frame
-        moment = np.zeros((self.n, 3))
-        np.add.at(moment, self.owner, cross(arm, local))
-        np.add.at(moment, self.ideal_owner,
-                  cross(self.ideal_arm, _apply_transposed(matrices[self.ideal_owner], per_ideal)))
+        ideal_local = _apply_transposed(matrices[self.ideal_owner], per_ideal)
+        moment = summed_rows(owners, np.concatenate([cross(arm, local), cross(self.ideal_arm, ideal_local)]), self.n)
         turn = np.einsum("bji,bj->bi", _right_jacobian(rotation), moment)
         unturned = np.zeros_like(per_atom)
         unturned[self.rows] = local
@@ -134,7 +131,7 @@ def refine_real_space(
         if objective > best["value"]:
             best.update(value=objective, x=x.copy())
         per_atom = per_atom - CLASH_WEIGHT * push
-        np.add.at(per_atom, bodies.ideal_on, 2.0 * JUNCTION_WEIGHT * off)
+        per_atom += summed_rows(bodies.ideal_on, 2.0 * JUNCTION_WEIGHT * off, len(per_atom))
         return -objective, -bodies.gradient(per_atom, -2.0 * JUNCTION_WEIGHT * off, placed)
 
     try:

@@ -18,7 +18,7 @@ import numpy as np
 
 from core.geometry.clash_list import CLASH_TARGET
 from core.geometry.topology import topology
-from core.geometry.vectors import distance, unit
+from core.geometry.vectors import distance, lengths, pair_gradient, unit
 from core.protein.model import EditableModel
 
 CHI_BONDS = {
@@ -130,18 +130,16 @@ class Clashes:
         self.i, self.j = top.close_pairs(model.coords, rows, -self.REACH)
         self.contact = top.contact(self.i, self.j)
         start = self.contact - distance(model.coords[self.i], model.coords[self.j])
-        self.allowed = np.maximum(start, CLASH_TARGET)  # overlap allowed, Å
+        self.limit = self.contact - np.maximum(start, CLASH_TARGET)  # Å: closer, a pair overlaps more than allowed
 
     def penalty(self, coords: np.ndarray) -> tuple[float, np.ndarray]:
         """Σ excess², and its gradient (n, 3)."""
         vector = coords[self.i] - coords[self.j]
-        length = np.maximum(np.linalg.norm(vector, axis=1), 1e-9)
-        excess = np.maximum(self.contact - length - self.allowed, 0.0)
-        force = (-2.0 * excess / length)[:, None] * vector
-        gradient = np.zeros_like(coords)
-        np.add.at(gradient, self.i, force)
-        np.add.at(gradient, self.j, -force)
-        return float(np.sum(excess**2)), gradient
+        length = np.maximum(lengths(vector), 1e-9)
+        hit = np.flatnonzero(length < self.limit)
+        excess = self.limit[hit] - length[hit]
+        force = (-2.0 * excess / length[hit])[:, None] * vector[hit]
+        return float(excess @ excess), pair_gradient(self.i[hit], self.j[hit], force, len(coords))
 
 
 def _rotate(vectors: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:

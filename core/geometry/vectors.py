@@ -47,6 +47,17 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
+def summed_rows(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """(n, 3): the rows of ``values`` (m, 3) added up by ``index`` (m,), as
+    ``np.add.at(out, index, values)`` does (as bincounts, several times faster)."""
+    return np.stack([np.bincount(index, values[:, k], n) for k in range(3)], axis=1)
+
+
+def pair_gradient(i: np.ndarray, j: np.ndarray, force: np.ndarray, n: int) -> np.ndarray:
+    """(n, 3): ``force`` (m, 3) on atoms ``i`` and its opposite on atoms ``j``, added up."""
+    return summed_rows(np.concatenate([i, j]), np.concatenate([force, -force]), n)
+
+
 def dihedral_gradients(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, ...]:
     """Dihedral angles a–b–c–d (radians; rows of (k, 3) arrays, as :func:`dihedral`) and
     their gradients (per Å) with respect to a and d."""
