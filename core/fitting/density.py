@@ -44,13 +44,14 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import replace
 
 import numpy as np
-from scipy import ndimage, optimize
+from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from core.curves.splines import spline_space
 from core.fitting.coarse_to_fine import LevelFit, pushed_to_finest
 from core.fitting.real_space import refine_real_space
 from core.fitting.settle import FIT_ITERATIONS, FitResult, settle
+from core.fitting.stoppable import minimize_until_cancelled
 from core.geometry.regularize import regularize_region
 from core.geometry.vectors import lengths, pair_gradient
 from core.protein.model import Edit, EditableModel, per_segment
@@ -317,8 +318,6 @@ def _fit_level(model: EditableModel, segments: Sequence[int], level: int,
                 for s, r, push, part in zip(segments, ribbons, pushes, parts)]
 
     def negative(x: np.ndarray) -> tuple[float, np.ndarray]:
-        if cancelled():
-            raise _Cancelled
         edits = plans(x)
         coords = model.coords.copy()
         for edit in edits:
@@ -334,18 +333,11 @@ def _fit_level(model: EditableModel, segments: Sequence[int], level: int,
             parts.append((design.T @ per_residue).ravel())
         return -value, -np.concatenate(parts)
 
-    try:
-        optimize.minimize(negative, np.zeros(sum(sizes)), jac=True, method="L-BFGS-B",
-                          options={"maxiter": ITERATIONS_PER_LEVEL, "gtol": 1e-9, "ftol": 1e-9})
-    except _Cancelled:
-        pass
+    minimize_until_cancelled(negative, np.zeros(sum(sizes)), cancelled,
+                             maxiter=ITERATIONS_PER_LEVEL, gtol=1e-9, ftol=1e-9)
     if "edits" not in best:
         return evaluate(model.coords)[1], []
     return best["cc"], best["edits"]
-
-
-class _Cancelled(Exception):
-    """Raised inside the optimiser to stop it."""
 
 
 def _inside(density: DensityMap, coords: np.ndarray) -> np.ndarray:

@@ -25,10 +25,10 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from scipy import optimize
 from scipy.spatial.transform import Rotation
 
 from core.fitting.side_chains import CLASH_WEIGHT, Clashes, side_chain_rotors
+from core.fitting.stoppable import minimize_until_cancelled
 from core.geometry.restraints import ideal_next
 from core.geometry.topology import topology
 from core.geometry.vectors import cross, summed_rows
@@ -121,8 +121,6 @@ def refine_real_space(
     best: dict = {"value": -np.inf, "x": np.zeros(bodies.size)}
 
     def negative(x: np.ndarray) -> tuple[float, np.ndarray]:
-        if cancelled():
-            raise _Cancelled
         coords, ideal, placed = bodies.place(x)
         value, per_atom = score(coords)
         overlap, push = clashes.penalty(coords)
@@ -134,10 +132,7 @@ def refine_real_space(
         per_atom += summed_rows(bodies.ideal_on, 2.0 * JUNCTION_WEIGHT * off, len(per_atom))
         return -objective, -bodies.gradient(per_atom, -2.0 * JUNCTION_WEIGHT * off, placed)
 
-    try:
-        optimize.minimize(negative, best["x"], jac=True, method="L-BFGS-B", options={"maxiter": iterations})
-    except _Cancelled:
-        pass
+    minimize_until_cancelled(negative, best["x"], cancelled, maxiter=iterations)
     coords = bodies.place(best["x"])[0]
     moved = np.zeros(bodies.n, dtype=bool)
     np.logical_or.at(moved, bodies.owner, np.any(coords[bodies.rows] != bodies.start[bodies.rows], axis=1))
@@ -151,10 +146,6 @@ def refine_real_space(
             points = model.ribbons[s].points
             edits.append(Edit(s, points, points, residues, rows, bodies.start[rows], coords[rows]))
     return edits
-
-
-class _Cancelled(Exception):
-    """Raised inside the optimiser to stop it."""
 
 
 def _apply(matrices: np.ndarray, vectors: np.ndarray) -> np.ndarray:

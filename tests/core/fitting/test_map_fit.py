@@ -8,7 +8,7 @@ import pytest
 from scipy import ndimage, sparse
 
 from core.fitting.density import MapTarget, atom_correlation, fit_map, gaussian_sigma, heavy_atoms, refine
-from core.fitting.real_space import ResidueBodies
+from core.fitting.real_space import ResidueBodies, refine_real_space
 from core.fitting.side_chains import side_chain_rotors
 from core.geometry.topology import topology
 from core.geometry.validation import validate
@@ -172,3 +172,33 @@ def test_residues_moved_off_their_map_refine_back_into_it_each_as_it_was(adk: Ed
     same = model.structure.atom_residue[i] == model.structure.atom_residue[j]
     before, after = (np.linalg.norm(c[i[same]] - c[j[same]], axis=1) for c in (adk.coords, model.coords))
     assert len(before) > len(rows) and np.abs(after - before).max() < 1e-9  # no residue changes shape
+
+
+def test_a_refinement_cancelled_stops_at_once_with_the_best_point_it_reached(adk: EditableModel) -> None:
+    """Cancel, asked at every evaluation, stops L-BFGS at the evaluation it says so; the
+    edits are those of the best point seen so far, between the start and a whole refinement."""
+    model = EditableModel(adk.structure)
+    target = _own_map(model)
+    bodies = ResidueBodies(model, [0])
+    model.coords = bodies.place(np.random.default_rng(5).normal(0.0, 0.3, bodies.size))[0]
+    rows = heavy_atoms(model)
+    correlation = atom_correlation(model, target)
+    evaluations = []
+
+    def score(coords: np.ndarray) -> tuple[float, np.ndarray]:
+        evaluations.append(1)
+        return correlation(coords)
+
+    def after(n: int | None) -> float:
+        evaluations.clear()
+        edits = refine_real_space(model, [0], score, cancelled=lambda: n is not None and len(evaluations) >= n)
+        coords = model.coords.copy()
+        for edit in edits:
+            coords[edit.rows] = edit.new_coords
+        return target.correlation(coords[rows])
+
+    start = target.correlation(model.coords[rows])
+    stopped = after(15)
+    assert len(evaluations) == 15  # no evaluation after Cancel
+    whole = after(None)
+    assert len(evaluations) > 50 and start < stopped < whole
