@@ -39,6 +39,7 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 from app.editor.document import Document
 from app.editor.surface_build import SurfaceBuild, start_server
 from app.polydata import scalar_style, to_polydata
+from core.geometry.vectors import summed_rows
 from core.surfaces.mesh import TriangleMesh
 
 if TYPE_CHECKING:
@@ -383,8 +384,7 @@ def _vertex_normals(mesh: TriangleMesh) -> np.ndarray:
     """(n_vertices, 3) unit normals: the area-weighted mean of the adjacent face normals."""
     a, b, c = (mesh.vertices[mesh.faces[:, k]] for k in range(3))
     weighted = np.repeat(np.cross(b - a, c - a), 3, axis=0)
-    index, n = mesh.faces.ravel(), len(mesh.vertices)
-    normals = np.column_stack([np.bincount(index, weighted[:, j], minlength=n) for j in range(3)])
+    normals = summed_rows(mesh.faces.ravel(), weighted, len(mesh.vertices))
     norm = np.linalg.norm(normals, axis=1, keepdims=True)
     return np.divide(normals, norm, out=np.zeros_like(normals), where=norm > 0)
 
