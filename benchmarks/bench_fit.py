@@ -19,6 +19,12 @@ residues paired by number, in both directions.
   transform cut sharply at the resolution, and noise), and into gemmi's electron density
   of the target (:func:`gemmi_map`). Anchor (published, not run here):
   iMODFIT fits GroEL (1AON into a 10 Å map of 1OEL) to 1.78 Å Cα rmsd, CC 0.982, in 244 s.
+* Every figure is the fit of the files as read, on one BLAS thread; beside it its spread
+  (``--starts N``, default 3): the same fit on two BLAS threads and from N starts whose
+  coordinates are perturbed by up to ±0.001 Å, all run side by side in processes of
+  their own (``--jobs``). The spread is the largest Cα rmsd between any two of the fitted
+  models, and the range of the figure over them (#31: a fit is converged when that spread
+  stays within 0.1 Å).
 * ``--others DIR``: the same for other pairs of conformations or homologues, files of DIR
   (:data:`OTHER_PAIRS`, chain A of each), the start first placed on the target by its
   paired Cα (as a rigid fit would place it), the Cα rmsd over the paired residues.
@@ -27,9 +33,13 @@ residues paired by number, in both directions.
 from __future__ import annotations
 
 import argparse
+import multiprocessing
 import os
 import tempfile
 import time
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
 
 import gemmi
@@ -56,6 +66,87 @@ OTHER_PAIRS = (("1TIM.pdb.gz", "8TIM.pdb.gz"), ("2AKY.pdb.gz", "1AKE.pdb.gz"), (
 """Triosephosphate isomerase (loop 6 closed onto open), yeast into E. coli adenylate kinase,
 dihydrofolate reductase (E. coli into human) and HPr (E. coli into B. subtilis)."""
 ELECTRONS = {"C": 6, "N": 7, "O": 8, "S": 16}
+PERTURBATION = 0.001
+"""Å: how far each start coordinate moves, at most, in the runs of the spread."""
+SPREAD_GOAL = 0.1
+"""Å: the most two runs of one fit may end apart (#31)."""
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of a fit: ``seed`` 0 starts from the file as read, others from its
+    coordinates perturbed; ``threads`` BLAS threads."""
+
+    seed: int
+    threads: int
+
+
+def runs(starts: int) -> list[Run]:
+    """The figure's run (as read, one thread), then two threads, then ``starts`` perturbed starts."""
+    return [Run(0, 1), Run(0, 2)] + [Run(seed, 1) for seed in range(1, starts + 1)]
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a run of a fit ends with: the paired Cα (k, 3), the figures printed, seconds."""
+
+    ca: np.ndarray
+    figures: dict[str, float]
+    seconds: float
+    text: str
+
+
+def started(structure: Structure, seed: int, folder: Path) -> Structure:
+    """``structure`` itself for seed 0, else with every coordinate moved by up to
+    :data:`PERTURBATION` Å, written to ``folder`` and read again."""
+    if seed == 0:
+        return structure
+    jitter = np.random.default_rng(seed).uniform(-PERTURBATION, PERTURBATION, structure.coords.shape)
+    return read_structure(write_structure(structure, structure.coords + jitter, folder / f"start_{seed}.pdb",
+                                          overwrite=True))
+
+
+def side_by_side(jobs: Sequence[tuple[Callable[..., Outcome], tuple]], plan: Sequence[Run],
+                 workers: int) -> list[list[Outcome]]:
+    """Every job ``(function, args)`` run as ``function(*args, seed)`` for each run of
+    ``plan``, each in a process of its own with the run's BLAS threads. Returns the
+    outcomes of each job, in the order of ``plan``."""
+    futures = {}
+    for threads in sorted({run.threads for run in plan}):
+        for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+            os.environ[name] = str(threads)  # read by the new processes' numpy when it loads
+        pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+        for j, (function, args) in enumerate(jobs):
+            for k, run in enumerate(plan):
+                if run.threads == threads:
+                    futures[j, k] = pool.submit(function, *args, run.seed)
+        pool.shutdown(wait=False)
+    return [[futures[j, k].result() for k in range(len(plan))] for j in range(len(jobs))]
+
+
+def apart(outcomes: Sequence[Outcome]) -> float:
+    """Å, the largest Cα rmsd between two of ``outcomes``."""
+    return float(max(np.sqrt(np.mean(np.sum((a.ca - b.ca) ** 2, axis=1))) for a in outcomes for b in outcomes))
+
+
+def spread(outcomes: Sequence[Outcome]) -> str:
+    """The largest Cα rmsd between two outcomes, and the range of each figure over them."""
+    distance = apart(outcomes)
+    values = {name: [o.figures[name] for o in outcomes] for name in outcomes[0].figures}
+    ranges = ", ".join(f"{name} {min(v):.3f}–{max(v):.3f}" for name, v in values.items())
+    flag = "" if distance <= SPREAD_GOAL else f" (over {SPREAD_GOAL} Å)"
+    return f"    spread over {len(outcomes)} runs: models {distance:.2f} Å apart at most{flag}; {ranges}"
+
+
+def report(jobs: Sequence[tuple[Callable[..., Outcome], tuple]], plan: Sequence[Run], workers: int) -> list[float]:
+    """Run ``jobs`` side by side, print each figure (its first run) and its spread; returns
+    the spreads (Å)."""
+    spreads = []
+    for outcomes in side_by_side(jobs, plan, workers):
+        print(outcomes[0].text)
+        print(spread(outcomes))
+        spreads.append(apart(outcomes))
+    return spreads
 
 
 def anm_rmsd(start: np.ndarray, target: np.ndarray, modes: tuple[int, ...]) -> dict[int, float]:
@@ -73,8 +164,11 @@ def anm_rmsd(start: np.ndarray, target: np.ndarray, modes: tuple[int, ...]) -> d
     return result
 
 
-def conformations(start_file: str, end_file: str) -> None:
-    start, end = read_structure(DATA / start_file), read_structure(DATA / end_file)
+def conformations(start_file: str, end_file: str, seed: int) -> Outcome:
+    """Fit ``start_file`` onto ``end_file`` (from start ``seed``) level by level, beside ANM."""
+    with tempfile.TemporaryDirectory() as scratch:
+        start = started(read_structure(DATA / start_file), seed, Path(scratch))
+    end = read_structure(DATA / end_file)
     name = f"{start_file.split('_')[0]} -> {end_file.split('_')[0]}"
     model = EditableModel(start)
     pairs, _ = pair_segments(model, [0], [end.segments[0]])
@@ -84,13 +178,14 @@ def conformations(start_file: str, end_file: str) -> None:
     began = time.perf_counter()
     result = fit_conformation(model, pairs, LEVELS)
     seconds = time.perf_counter() - began
-    print(f"\n{name}: Cα rmsd {superpose(start.coords[rows], target).rmsd:.2f} Å at the start")
-    print(f"  {'level':>5} {'control points':>15} {'unknowns':>9} {'rmsd Å':>7}    {'ANM modes':>9} {'rmsd Å':>7}")
+    lines = [f"\n{name}: Cα rmsd {superpose(start.coords[rows], target).rmsd:.2f} Å at the start",
+             f"  {'level':>5} {'control points':>15} {'unknowns':>9} {'rmsd Å':>7}    {'ANM modes':>9} {'rmsd Å':>7}"]
     for fit, modes in zip(result.levels, MODES):
-        print(f"  {fit.level:>5} {fit.control_points:>15} {3 * fit.control_points:>9} {fit.score:>7.2f}    "
-              f"{modes:>9} {anm[modes]:>7.2f}")
-    final = superpose(model.coords[rows], target).rmsd
-    print(f"  regularized fit: Cα rmsd {final:.2f} Å in {seconds:.1f} s; " + _checks(start, model.coords))
+        lines.append(f"  {fit.level:>5} {fit.control_points:>15} {3 * fit.control_points:>9} {fit.score:>7.2f}    "
+                     f"{modes:>9} {anm[modes]:>7.2f}")
+    final = superpose(model.coords[rows], target)
+    lines.append(f"  regularized fit: Cα rmsd {final.rmsd:.2f} Å in {seconds:.1f} s; " + _checks(start, model.coords))
+    return Outcome(model.coords[rows].copy(), {"Cα rmsd": final.rmsd}, seconds, "\n".join(lines))
 
 
 def _checks(structure: Structure, coords: np.ndarray) -> str:
@@ -146,8 +241,8 @@ def gemmi_map(structure: Structure, resolution: float) -> DensityMap:
     return DensityMap(values.astype(np.float32), density.origin, density.axes)
 
 
-def map_fit(label: str, start: Structure, end: Structure, density: DensityMap, resolution: float) -> None:
-    """Fit ``start`` (its first segment) into ``density`` of ``end`` and print CC, Cα rmsd and time."""
+def map_fit(label: str, start: Structure, end: Structure, density: DensityMap, resolution: float) -> Outcome:
+    """Fit ``start`` (its first segment) into ``density`` of ``end``: CC, Cα rmsd and time."""
     model = EditableModel(start)
     pairs, _ = pair_segments(model, [0], [end.segments[0]])
     rows, target_ca = ca_rows(start)[start.segments[0].residue_index[pairs[0].residues]], pairs[0].target
@@ -161,15 +256,22 @@ def map_fit(label: str, start: Structure, end: Structure, density: DensityMap, r
     began = time.perf_counter()
     result = fit_map(model, [0], target, LEVELS)
     seconds = time.perf_counter() - began
-    print(f"  {label} at {resolution:>4g} Å: CC {first[0]:.3f} -> {target.correlation(model.coords[heavy]):.3f}, "
-          f"Cα rmsd {first[1]:.2f} -> {rmsd():.2f} Å ({len(rows)} Cα), {seconds:.1f} s (levels "
-          + ", ".join(f"{f.level}: {f.score:.3f}" for f in result.levels) + ")")
+    cc, final = target.correlation(model.coords[heavy]), rmsd()
+    dropped = f", level {', '.join(map(str, result.dropped))} undone" if result.dropped else ""
+    levels = ", ".join(f"{f.level}: {f.score:.3f}" for f in result.levels)
+    text = (f"  {label} at {resolution:>4g} Å: CC {first[0]:.3f} -> {cc:.3f}, Cα rmsd {first[1]:.2f} -> {final:.2f} Å "
+            f"({len(rows)} Cα), {seconds:.1f} s (levels {levels}{dropped})")
+    return Outcome(model.coords[rows].copy(), {"CC": cc, "Cα rmsd": final}, seconds, text)
 
 
-def maps(start_file: str, end_file: str, resolution: float, made: str = "molmap") -> None:
-    start, end = read_structure(DATA / start_file), read_structure(DATA / end_file)
+def maps(start_file: str, end_file: str, resolution: float, made: str, seed: int) -> Outcome:
+    """Fit ``start_file`` (from start ``seed``) into a map of ``end_file`` made by ``made``."""
+    end = read_structure(DATA / end_file)
     density = {"molmap": simulated_map, "x-ray-like": xray_like_map, "gemmi": gemmi_map}[made](end, resolution)
-    map_fit(f"{start_file.split('_')[0]} into {end_file.split('_')[0]} ({made})", start, end, density, resolution)
+    with tempfile.TemporaryDirectory() as scratch:
+        start = started(read_structure(DATA / start_file), seed, Path(scratch))
+    label = f"{start_file.split('_')[0]} into {end_file.split('_')[0]} ({made})"
+    return map_fit(label, start, end, density, resolution)
 
 
 def chain_a(path: Path, folder: Path) -> Structure:
@@ -190,40 +292,47 @@ def chain_a(path: Path, folder: Path) -> Structure:
     return read_structure(out)
 
 
-def others(folder: Path, resolution: float) -> None:
+def other(folder: Path, start_file: str, end_file: str, resolution: float, seed: int) -> Outcome:
+    """Fit chain A of ``start_file``, placed on chain A of ``end_file`` by their paired Cα,
+    into a molmap map of it (from start ``seed``)."""
     with tempfile.TemporaryDirectory() as scratch:
-        for start_file, end_file in OTHER_PAIRS:
-            start, end = chain_a(folder / start_file, Path(scratch)), chain_a(folder / end_file, Path(scratch))
-            model = EditableModel(start)
-            pairs, _ = pair_segments(model, [0], [end.segments[0]])
-            rows = ca_rows(start)[start.segments[0].residue_index[pairs[0].residues]]
-            placed = superpose(pairs[0].target, start.coords[rows]).apply(start.coords)  # rigid, onto the target
-            moved = read_structure(write_structure(start, placed, Path(scratch) / f"placed_{start_file}.pdb",
-                                                   overwrite=True))
-            name = f"{start_file.split('.')[0]} into {end_file.split('.')[0]}"
-            map_fit(name, moved, end, simulated_map(end, resolution), resolution)
+        start, end = chain_a(folder / start_file, Path(scratch)), chain_a(folder / end_file, Path(scratch))
+        model = EditableModel(start)
+        pairs, _ = pair_segments(model, [0], [end.segments[0]])
+        rows = ca_rows(start)[start.segments[0].residue_index[pairs[0].residues]]
+        placed = superpose(pairs[0].target, start.coords[rows]).apply(start.coords)  # rigid, onto the target
+        moved = read_structure(write_structure(start, placed, Path(scratch) / f"placed_{start_file}.pdb",
+                                               overwrite=True))
+        moved = started(moved, seed, Path(scratch))
+    name = f"{start_file.split('.')[0]} into {end_file.split('.')[0]}"
+    return map_fit(name, moved, end, simulated_map(end, resolution), resolution)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--maps", action="store_true", help="also fit into simulated maps (several minutes)")
     parser.add_argument("--others", type=Path, metavar="DIR", help="also fit other pairs (OTHER_PAIRS) from DIR")
+    parser.add_argument("--starts", type=int, default=3, metavar="N",
+                        help="perturbed starts of each fit for its spread (default 3; 0: two thread counts only)")
+    parser.add_argument("--jobs", type=int, default=os.cpu_count(), help="fits run side by side (default: the cores)")
     args = parser.parse_args()
     prody.confProDy(verbosity="none")
+    plan = runs(args.starts)
     print(f"load average: {' '.join(f'{x:.2f}' for x in os.getloadavg())} on {os.cpu_count()} cores; "
-          f"ProDy {prody.__version__}")
-    for pair in ((OPEN, CLOSED), (CLOSED, OPEN)):
-        conformations(*pair)
+          f"ProDy {prody.__version__}; {len(plan)} runs of each fit ({args.jobs} side by side): as read on 1 and 2 "
+          f"BLAS threads, {args.starts} starts perturbed by up to ±{PERTURBATION} Å")
+    spreads = report([(conformations, pair) for pair in ((OPEN, CLOSED), (CLOSED, OPEN))], plan, args.jobs)
     if args.maps:
         print("\nInto simulated maps (anchor: iMODFIT, GroEL at 10 Å: 1.78 Å, CC 0.982, 244 s):")
-        for made in ("molmap", "x-ray-like", "gemmi"):
-            for resolution in (10.0, 6.0):
-                for pair in ((OPEN, CLOSED), (CLOSED, OPEN)):
-                    maps(*pair, resolution, made)
+        spreads += report([(maps, (*pair, resolution, made)) for made in ("molmap", "x-ray-like", "gemmi")
+                           for resolution in (10.0, 6.0) for pair in ((OPEN, CLOSED), (CLOSED, OPEN))], plan, args.jobs)
     if args.others:
         print("\nOther proteins, into molmap maps of the target:")
-        for resolution in (10.0, 6.0):
-            others(args.others, resolution)
+        spreads += report([(other, (args.others, *pair, resolution)) for resolution in (10.0, 6.0)
+                           for pair in OTHER_PAIRS], plan, args.jobs)
+    within = sum(s <= SPREAD_GOAL for s in spreads)
+    print(f"\nspread: {within} of {len(spreads)} fits end within {SPREAD_GOAL} Å of themselves over every run; "
+          f"the largest {max(spreads):.2f} Å")
 
 
 if __name__ == "__main__":
