@@ -38,7 +38,7 @@ import os
 import tempfile
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -107,10 +107,10 @@ def started(structure: Structure, seed: int, folder: Path) -> Structure:
 
 
 def side_by_side(jobs: Sequence[tuple[Callable[..., Outcome], tuple]], plan: Sequence[Run],
-                 workers: int) -> list[list[Outcome]]:
-    """Every job ``(function, args)`` run as ``function(*args, seed)`` for each run of
-    ``plan``, each in a process of its own with the run's BLAS threads. Returns the
-    outcomes of each job, in the order of ``plan``."""
+                 workers: int) -> list[list[Future]]:
+    """Every job ``(function, args)`` submitted as ``function(*args, seed)`` for each run of
+    ``plan``, each in a process of its own with the run's BLAS threads. Returns the futures
+    of each job's outcomes, in the order of ``plan``."""
     futures = {}
     for threads in sorted({run.threads for run in plan}):
         for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
@@ -121,7 +121,7 @@ def side_by_side(jobs: Sequence[tuple[Callable[..., Outcome], tuple]], plan: Seq
                 if run.threads == threads:
                     futures[j, k] = pool.submit(function, *args, run.seed)
         pool.shutdown(wait=False)
-    return [[futures[j, k].result() for k in range(len(plan))] for j in range(len(jobs))]
+    return [[futures[j, k] for k in range(len(plan))] for j in range(len(jobs))]
 
 
 def apart(outcomes: Sequence[Outcome]) -> float:
@@ -142,8 +142,9 @@ def report(jobs: Sequence[tuple[Callable[..., Outcome], tuple]], plan: Sequence[
     """Run ``jobs`` side by side, print each figure (its first run) and its spread; returns
     the spreads (Å)."""
     spreads = []
-    for outcomes in side_by_side(jobs, plan, workers):
-        print(outcomes[0].text)
+    for futures in side_by_side(jobs, plan, workers):
+        outcomes = [future.result() for future in futures]
+        print(outcomes[0].text, flush=True)
         print(spread(outcomes))
         spreads.append(apart(outcomes))
     return spreads

@@ -105,8 +105,8 @@ def run_fit(args: argparse.Namespace) -> int:
         print(f"  level {f.level}: {f.control_points:4d} control points, {name} {f.score:6.3f}{unit}{seen}, "
               f"{f.seconds:6.2f} s")
     if result.dropped:
-        print(f"  levels {', '.join(map(str, result.dropped))} undone: the regularized model kept more bad peptide "
-              "junctions than the input (the target's backbone differs at that detail)")
+        print(f"  levels {', '.join(map(str, result.dropped))} undone: the regularized model kept clearly more bad "
+              "peptide junctions and Ramachandran outliers than the input (the target's backbone differs at that detail)")
     if result.refinement:
         print("  refined: every residue moved into the map on its own, its side chains turning, and regularized")
     done = "regularized" if args.regularize else "not regularized"

@@ -141,7 +141,7 @@ def _settle(document: Document, target: FitTarget, fits: list[LevelFit], progres
     progress.setLabelText("Regularizing…")
     QApplication.processEvents()
     result = settle(document.model, fits, cancelled=cancelled, undo=undo)
-    undone = f" (level {', '.join(map(str, result.dropped))} undone: bad peptide junctions)" if result.dropped else ""
+    undone = f" (level {', '.join(map(str, result.dropped))} undone: bad junctions, Ramachandran outliers)" if result.dropped else ""
     if result.regularization:
         document.push_applied(result.regularization, f"Regularize the fit to {target.name}{undone}")
     if target.refine is not None and result.levels and not progress.wasCanceled():

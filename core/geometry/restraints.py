@@ -95,11 +95,18 @@ class Restraints:
     difference of two points with a 3 x 3 matrix (one residual per row); distance terms
     ask two points to be ``d0`` apart; Ramachandran terms a φ or ψ to be allowed; clash
     terms two atoms to be at least ``d_min`` apart. Residuals come in that order.
+    ``softness`` multiplies the σ of the stiff terms (junctions, clashes, Ramachandran), for
+    a relaxation that starts loose and tightens (:func:`core.geometry.regularize.relax`);
+    ``held`` (m, 3) is where each Cα is held (default: where it is).
     """
 
     def __init__(self, structure: Structure, coords: np.ndarray, residues: np.ndarray,
-                 anchors: np.ndarray, tangents: np.ndarray, reference: np.ndarray, side_chains: bool) -> None:
+                 anchors: np.ndarray, tangents: np.ndarray, reference: np.ndarray, side_chains: bool,
+                 softness: float = 1.0, held: np.ndarray | None = None) -> None:
         top = topology(structure)
+        self.junction_sigma = JUNCTION_SIGMA * softness
+        self.clash_sigma = CLASH_SIGMA * softness
+        self.ramachandran_sigma = RAMACHANDRAN_SIGMA * softness
         self.n_bodies = n = len(residues)
         bb = top.backbone
         body_of = np.full(len(bb), -1)
@@ -136,7 +143,7 @@ class Restraints:
         full = (bb[first, 1:4] >= 0).all(axis=1) & (bb[second, :2] >= 0).all(axis=1)
         before, after = first[full], second[full]
         ideal_n, ideal_ca = ideal_next(coords, bb[before], bb[after], top.cis[k[full]], top.proline[k[full]])
-        stiff = np.eye(3) / JUNCTION_SIGMA
+        stiff = np.eye(3) / self.junction_sigma
         coincide((ideal_n, body_of[before], PSI), (coords[bb[after, 0]], body_of[after]), stiff)
         coincide((ideal_ca, body_of[before], PSI), (coords[bb[after, 1]], body_of[after]), stiff)
         self.n_junction_rows = 6 * len(before)  # the first rows: N and Cα of the next residue, 3 each
@@ -149,7 +156,8 @@ class Restraints:
         along = unit(tangents)
         weights = np.concatenate([_normal_planes(along) / TETHER_SIGMA, along[:, None] / SLIDE_SIGMA], axis=1)
         coincide((anchors, np.full(n, -1)), (anchors, np.arange(n)), weights)
-        coincide((self.centre, np.full(n, -1)), (self.centre, np.arange(n)), np.eye(3) / HOLD_SIGMA)
+        held = self.centre if held is None else held
+        coincide((held, np.full(n, -1)), (self.centre, np.arange(n)), np.eye(3) / HOLD_SIGMA)
         # torsions held loosely (each a turn of a point about a bond, 2 r sin(angle / 2) long):
         # ψ and χ1, the first heavy atom each rotor turns against the same atom unturned; φ, each C
         # on its residue against the same C on the carbonyl before it
@@ -214,7 +222,7 @@ class Restraints:
         degrees = np.degrees(angle)
         target = np.concatenate(nearest_allowed(degrees[:m], degrees[m:], self.rama_kind))
         off = np.where(target != degrees, (angle - np.radians(target) + np.pi) % (2 * np.pi) - np.pi, 0.0)
-        sigma = np.radians(RAMACHANDRAN_SIGMA)
+        sigma = np.radians(self.ramachandran_sigma)
         gradient = np.concatenate([first[:m], last[m:]]) * ((off != 0) / sigma)[:, None]
         return off / sigma, gradient, np.concatenate([p[:, 0], p[:, 4]])
 
@@ -242,9 +250,10 @@ class Restraints:
         by more than CLASH_OVERLAP)."""
         start = self.n_vector_rows
         stop = start + len(self.distance_d0)
-        junction = np.abs(np.concatenate([residual[: self.n_junction_rows], residual[start:stop]])) * JUNCTION_SIGMA
+        junction = np.abs(np.concatenate([residual[: self.n_junction_rows], residual[start:stop]]))
+        junction *= self.junction_sigma
         rama = residual[stop : stop + 2 * len(self.rama_atoms)]
-        clash = residual[stop + len(rama) :] * CLASH_SIGMA
+        clash = residual[stop + len(rama) :] * self.clash_sigma
         return bool(np.any(junction > JUNCTION_SLACK) or np.any(rama != 0)
                     or np.any(clash < CLASH_TARGET - CLASH_OVERLAP))
 
@@ -259,7 +268,7 @@ class Restraints:
         n_distance = len(self.distance_d0)
         pair_a = np.concatenate([x[self.distance_a], current[i]])
         vector = np.concatenate([x[self.distance_b], current[j]]) - pair_a
-        sigma = np.concatenate([np.full(n_distance, JUNCTION_SIGMA), np.full(len(i), CLASH_SIGMA)])
+        sigma = np.concatenate([np.full(n_distance, self.junction_sigma), np.full(len(i), self.clash_sigma)])
         length = lengths(vector)
         gap = length - np.concatenate([self.distance_d0, d_min])
         value, slope = gap.copy(), np.ones(len(gap))

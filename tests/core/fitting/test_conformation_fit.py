@@ -10,7 +10,7 @@ from core.analysis.superpose import superpose
 from core.fitting.coarse_to_fine import pushed_to_finest
 from core.fitting.conformation import SAME_FOLD, fit_conformation, fold_similarity, pair_segments
 from core.fitting.morph import morph_frames
-from core.fitting.settle import MIN_JUNCTION_MARGIN
+from core.fitting.settle import MIN_MARGIN
 from core.geometry.validation import validate
 from core.protein.model import EditableModel
 from core.protein.reading import read_structure
@@ -42,14 +42,11 @@ def test_adenylate_kinase_reaches_the_other_conformation(start: str, end: str, f
     assert rmsd[0] < 0.7 * initial and rmsd[-1] < 1.0
     final = superpose(model.coords[rows], pairs[0].target).rmsd
     assert final <= 1.5
-    before, report = validate(structure).counts, validate(structure, model.coords)
-    after = report.counts
-    # the whole chain's regularization settles in one of many minima: from some starts a
-    # junction stays open, just past its tolerance (C–N 1.274 Å against 1.33 ± 0.05)
-    assert after["peptide_bond"] + after["ca_ca"] <= before["peptide_bond"] + before["ca_ca"] + MIN_JUNCTION_MARGIN
-    assert all(abs(flag.value - flag.ideal) < 0.1 for flag in report.flags if flag.kind == "peptide_bond")
+    before, after = validate(structure).counts, validate(structure, model.coords).counts
+    # a whole chain's junctions close in one of many minima: from some starts one or two stay open
+    assert after["peptide_bond"] + after["ca_ca"] <= before["peptide_bond"] + before["ca_ca"] + MIN_MARGIN
     assert after["clash"] - before["clash"] <= 2 * structure.n_atoms / 1000
-    assert after["ramachandran"] - before["ramachandran"] <= 0.02 * structure.n_residues  # 2 -> 4 or 5 of 214
+    assert after["ramachandran"] - before["ramachandran"] <= 0.01 * structure.n_residues
 
 
 def test_each_level_changes_only_its_own_control_points_and_undoes_exactly() -> None:
