@@ -88,11 +88,10 @@ def runs(starts: int) -> list[Run]:
 
 @dataclass(frozen=True)
 class Outcome:
-    """What a run of a fit ends with: the paired Cα (k, 3), the figures printed, seconds."""
+    """What a run of a fit ends with: the paired Cα (k, 3), its figures, and what it prints."""
 
     ca: np.ndarray
     figures: dict[str, float]
-    seconds: float
     text: str
 
 
@@ -186,7 +185,7 @@ def conformations(start_file: str, end_file: str, seed: int) -> Outcome:
                      f"{modes:>9} {anm[modes]:>7.2f}")
     final = superpose(model.coords[rows], target)
     lines.append(f"  regularized fit: Cα rmsd {final.rmsd:.2f} Å in {seconds:.1f} s; " + _checks(start, model.coords))
-    return Outcome(model.coords[rows].copy(), {"Cα rmsd": final.rmsd}, seconds, "\n".join(lines))
+    return Outcome(model.coords[rows].copy(), {"Cα rmsd": final.rmsd}, "\n".join(lines))
 
 
 def _checks(structure: Structure, coords: np.ndarray) -> str:
@@ -262,7 +261,7 @@ def map_fit(label: str, start: Structure, end: Structure, density: DensityMap, r
     levels = ", ".join(f"{f.level}: {f.score:.3f}" for f in result.levels)
     text = (f"  {label} at {resolution:>4g} Å: CC {first[0]:.3f} -> {cc:.3f}, Cα rmsd {first[1]:.2f} -> {final:.2f} Å "
             f"({len(rows)} Cα), {seconds:.1f} s (levels {levels}{dropped})")
-    return Outcome(model.coords[rows].copy(), {"CC": cc, "Cα rmsd": final}, seconds, text)
+    return Outcome(model.coords[rows].copy(), {"CC": cc, "Cα rmsd": final}, text)
 
 
 def maps(start_file: str, end_file: str, resolution: float, made: str, seed: int) -> Outcome:
