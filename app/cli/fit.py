@@ -25,7 +25,8 @@ from core.geometry.validation import validate
 from core.protein.model import EditableModel
 from core.protein.structure import Structure, ca_rows
 from core.protein.writing import write_models
-from core.surfaces.volume import MapError, read_map
+from core.surfaces.map_file import read_map
+from core.surfaces.volume import MapError
 
 DEFAULT_LEVELS = (0, 6)
 MAP_SUFFIXES = (".ccp4", ".mrc", ".map")

@@ -23,9 +23,10 @@ from core.protein.reading import read_atoms
 from core.protein.structure import AtomTable, StructureError
 from core.surfaces.dna import ideal_bdna
 from core.surfaces.levelled import KINDS, UNITS, LevelledSurface, build_surface
+from core.surfaces.map_file import read_map
 from core.surfaces.mesh import TriangleMesh
 from core.surfaces.molecular import COLOURINGS
-from core.surfaces.volume import MapError, read_map
+from core.surfaces.volume import MapError
 
 OUTPUTS = (".vtp", ".ply", ".png")
 MAP_SUFFIXES = (".ccp4", ".map", ".mrc")
@@ -137,7 +138,7 @@ def _write(mesh: TriangleMesh, scalars: np.ndarray | None, colouring: str | None
         raise
 
 
-def _render(polydata, scalars: np.ndarray | None, colouring: str | None, path: str) -> None:  # noqa: ANN001
+def _render(polydata, scalars: np.ndarray | None, colouring: str | None, path: str) -> None:
     import pyvista as pv
 
     plotter = pv.Plotter(off_screen=True, window_size=(900, 900))

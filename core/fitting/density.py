@@ -112,16 +112,14 @@ class MapTarget:
         self._around, self._margin = around, margin
         self._blurred: dict[float, MapTarget] = {}
         margin = 3.0 * self.sigma + 5.0 if margin is None else margin
-        inside = _inside(density, around)
+        inside = density.covers(around)
         if inside.mean() < MIN_OVERLAP:
             raise MapError(f"the map does not overlap the model: {inside.mean():.0%} of its atoms lie inside the map "
                            f"(at least {MIN_OVERLAP:.0%} must)")
         self.origin = around.min(axis=0) - margin
         self.shape = tuple(np.ceil((around.max(axis=0) + margin - self.origin) / self.spacing).astype(int) + 1)
         points = self.origin + np.stack(np.indices(self.shape), axis=-1).reshape(-1, 3) * self.spacing
-        index = (points - density.origin) @ np.linalg.inv(density.axes)
-        values = ndimage.map_coordinates(density.values.astype(np.float64), index.T, order=1, mode="nearest")
-        values = values.reshape(self.shape)
+        values = density.interpolate(points).reshape(self.shape)
         self._target = values - values.mean()
         self._target_norm = _norm(self._target)
         if self._target_norm == 0.0:
@@ -338,12 +336,6 @@ def _fit_level(model: EditableModel, segments: Sequence[int], level: int,
     if "edits" not in best:
         return evaluate(model.coords)[1], []
     return best["cc"], best["edits"]
-
-
-def _inside(density: DensityMap, coords: np.ndarray) -> np.ndarray:
-    """Whether each of ``coords`` lies inside the map's grid."""
-    index = (coords - density.origin) @ np.linalg.inv(density.axes)
-    return np.all((index >= 0) & (index <= np.array(density.values.shape) - 1), axis=1)
 
 
 def fit_map(

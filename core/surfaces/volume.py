@@ -1,5 +1,5 @@
-"""Density maps: read CCP4/MRC files or compute one from a model (gemmi), 3-D wavelet
-levels (PyWavelets) and contour surfaces (marching cubes).
+"""Density maps: computed from a model (gemmi), 3-D wavelet levels (PyWavelets) and
+contour surfaces (marching cubes); :mod:`core.surfaces.map_file` reads them.
 
 A map is a grid of values with an affine map from grid indices to Å, so that skewed unit
 cells need no resampling. Wavelet level ``L`` of a map with ``n`` levels keeps the
@@ -9,15 +9,14 @@ itself, level 0 its coarsest approximation.
 
 from __future__ import annotations
 
-import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
-from pathlib import Path
 
 import gemmi
 import numpy as np
 import pywt
 from numpy.typing import NDArray
+from scipy import ndimage
 from skimage.measure import marching_cubes
 
 from core.protein.structure import AtomTable
@@ -47,11 +46,15 @@ class DensityMap:
     axes : (3, 3) float64, Å
         Rows: the steps of the grid along its three axes (a diagonal of spacings for an
         orthogonal cell).
+    periodic : whether the grid is one unit cell of a crystal, repeated through space.
+    resolution : Å, the map's resolution where its file says it, else None.
     """
 
     values: NDArray[np.float32]
     origin: NDArray[np.float64]
     axes: NDArray[np.float64]
+    periodic: bool = False
+    resolution: float | None = None
 
     @cached_property
     def _coefficients(self) -> list:
@@ -72,7 +75,7 @@ class DensityMap:
         dropped = [{key: np.zeros_like(c) for key, c in detail.items()} for detail in self._coefficients[level + 1 :]]
         values = pywt.waverecn(kept + dropped, WAVELET, mode="symmetric")
         values = values[tuple(slice(0, n) for n in self.values.shape)]
-        return DensityMap(values.astype(np.float32), self.origin, self.axes)
+        return replace(self, values=values.astype(np.float32))
 
     @cached_property
     def moments(self) -> tuple[float, float]:
@@ -91,6 +94,23 @@ class DensityMap:
         vertices, faces, _, _ = marching_cubes(self.values, value, allow_degenerate=False)
         return TriangleMesh(self.origin + vertices @ self.axes, faces[:, ::-1])
 
+    def grid_index(self, points: np.ndarray) -> np.ndarray:
+        """(n, 3) grid coordinates (fractional indices) of ``points`` (n, 3), Å."""
+        return (np.asarray(points, dtype=np.float64) - self.origin) @ np.linalg.inv(self.axes)
+
+    def covers(self, points: np.ndarray) -> np.ndarray:
+        """Whether each of ``points`` (n, 3), Å, lies within the map (everywhere for a periodic map)."""
+        index = self.grid_index(points)
+        if self.periodic:
+            return np.ones(len(index), dtype=bool)
+        return np.all((index >= 0) & (index <= np.array(self.values.shape) - 1), axis=1)
+
+    def interpolate(self, points: np.ndarray) -> np.ndarray:
+        """The map's values at ``points`` (n, 3), Å, interpolated trilinearly (beyond a box,
+        the value at its nearest face; a periodic map repeats)."""
+        mode = "grid-wrap" if self.periodic else "nearest"
+        return ndimage.map_coordinates(self.values.astype(np.float64), self.grid_index(points).T, order=1, mode=mode)
+
     def contour_around(self, value: float, centre: np.ndarray, radius: float) -> TriangleMesh:
         """Isosurface at ``value`` within ``radius`` Å of ``centre`` (Å), as maps are drawn in
         model building: marching cubes on the block of the grid that holds the sphere, the
@@ -98,10 +118,13 @@ class DensityMap:
         Empty where the map does not reach or the block does not cross ``value``."""
         centre = np.asarray(centre, dtype=np.float64)
         corners = centre + radius * (2.0 * np.array(list(np.ndindex(2, 2, 2))) - 1.0)
-        index = (corners - self.origin) @ np.linalg.inv(self.axes)
-        low = np.clip(np.floor(index.min(axis=0)).astype(int), 0, self.values.shape)
-        high = np.clip(np.ceil(index.max(axis=0)).astype(int) + 1, 0, self.values.shape)
-        block = self.values[tuple(slice(a, b) for a, b in zip(low, high))]
+        index = self.grid_index(corners)
+        low, high = np.floor(index.min(axis=0)).astype(int), np.ceil(index.max(axis=0)).astype(int) + 1
+        if self.periodic:  # the cell repeated around the centre, as Coot draws a crystal's map
+            block = self.values[np.ix_(*[np.arange(a, b) % n for a, b, n in zip(low, high, self.values.shape)])]
+        else:
+            low, high = np.clip(low, 0, self.values.shape), np.clip(high, 0, self.values.shape)
+            block = self.values[tuple(slice(a, b) for a, b in zip(low, high))]
         empty = TriangleMesh(np.empty((0, 3)), np.empty((0, 3), dtype=np.int64))
         if min(block.shape) < 2 or not block.min() < value < block.max():
             return empty
@@ -113,30 +136,6 @@ class DensityMap:
         used[faces] = True
         renumbered = np.cumsum(used) - 1
         return TriangleMesh(vertices[used], renumbered[faces[:, ::-1]])
-
-
-def read_map(path: str | os.PathLike[str]) -> DensityMap:
-    """Read a CCP4/MRC map (optionally gzipped); the whole unit cell, gaps filled with the mean."""
-    path = Path(path)
-    if not path.exists():
-        raise MapError(f"{path}: no such file")
-    if not path.is_file():
-        raise MapError(f"{path}: not a regular file (a folder, device or FIFO is not read)")
-    try:
-        ccp4 = gemmi.read_ccp4_map(str(path))
-        ccp4.setup(float("nan"), gemmi.MapSetup.Full)
-    except (RuntimeError, ValueError) as exc:
-        raise MapError(f"{path}: not a readable CCP4/MRC map ({exc})") from None
-    grid = ccp4.grid
-    values = np.array(grid.array, dtype=np.float32)
-    finite = np.isfinite(values)
-    if not finite.any():
-        raise MapError(f"{path}: the map holds no finite values")
-    values[~finite] = values[finite].mean()
-    orth = np.array(grid.unit_cell.orth.mat.tolist())
-    axes = (orth / np.array(values.shape)).T
-    origin = np.array([ccp4.header_float(k) for k in (50, 51, 52)], dtype=np.float64)
-    return DensityMap(values, origin, axes)
 
 
 def model_density(atoms: AtomTable, *, spacing: float = 0.75, resolution: float = 3.0, margin: float = 5.0) -> DensityMap:

@@ -70,7 +70,9 @@ class MapMesh(QObject):
     def open(self, path: Path) -> None:
         """Read the CCP4/MRC map at ``path`` (optionally gzipped; raises
         :class:`core.surfaces.volume.MapError`) and draw it instead of the one open."""
-        from core.surfaces.volume import read_map  # the map code (scikit-image, PyWavelets) loads with the first map
+        from core.surfaces.map_file import (
+            read_map,  # the map code (scikit-image, PyWavelets) loads with the first map
+        )
 
         self.density, self.path = read_map(path), Path(path)
         self.contour()

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from core.protein.reading import read_atoms
-from core.surfaces.volume import DensityMap, MapError, model_density, read_map
+from core.surfaces.map_file import read_map
+from core.surfaces.volume import DensityMap, model_density
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 
@@ -79,14 +80,6 @@ def test_contour_around_a_point_is_the_contour_near_it(density: DensityMap) -> N
     assert np.min(np.linalg.norm(whole.vertices[inner][:, None] - near.vertices[None], axis=2), axis=1).max() < 1e-4
     assert density.contour_around(value, centre + 500.0, 8.0).n_faces == 0  # outside the map
     assert density.contour_around(1e6, centre, 8.0).n_faces == 0  # no density that high
-
-
-def test_bad_map_files(tmp_path: Path) -> None:
-    with pytest.raises(MapError, match="no such file"):
-        read_map(tmp_path / "missing.ccp4")
-    (tmp_path / "junk.map").write_bytes(b"not a map at all" * 100)
-    with pytest.raises(MapError, match="not a readable"):
-        read_map(tmp_path / "junk.map")
 
 
 def test_models_without_b_factors_give_a_finite_density() -> None:

@@ -1,0 +1,174 @@
+"""CCP4/MRC map files read as the format says (MRC-2014 and CCP4's conventions), where each
+voxel lies as ``mrcfile`` and ChimeraX place it.
+
+- **Byte order** from the machine stamp, or, where a program wrote none (0, as iMOD and
+  Situs do), from the header itself: the order in which the mode, the grid size and the
+  axis order make sense.
+- **Modes** 0 (int8), 1 (int16), 2 (float32), 6 (uint16) and 12 (float16).
+- **Axis order** MAPC/MAPR/MAPS: the values come out indexed ``[x, y, z]``.
+- **Placement**: voxel ``i`` (along x, y, z) lies at ``ORIGIN + i · step`` where the MRC-2014
+  ORIGIN words are not all zero, else at ``(start + i) · step``, with the steps the cell's
+  axes over their samplings (MX, MY, MZ), as ChimeraX places them.
+- **Crystallographic maps**, a box smaller than its cell or a space group beyond P1, are
+  periodic: they are expanded to the whole cell with the space group's symmetry (gemmi),
+  and sampled around a model wherever it lies (:attr:`DensityMap.periodic`).
+- gzipped files; the extended header skipped.
+"""
+
+from __future__ import annotations
+
+import gzip
+import os
+import re
+from pathlib import Path
+from typing import BinaryIO
+
+import gemmi
+import numpy as np
+
+from core.surfaces.volume import DensityMap, MapError
+
+MODES = {0: np.int8, 1: np.int16, 2: np.float32, 6: np.uint16, 12: np.float16}
+"""The MRC modes of density values and their types (little-endian; swapped as the file says)."""
+MAX_VOXELS = 1024**3
+"""The largest map read (4 GiB as float32): a bigger header is refused before any data is read."""
+HEADER_BYTES = 1024
+
+_RESOLUTION_LABEL = re.compile(r"resolution[^0-9]{0,12}(\d+(?:\.\d+)?)", re.IGNORECASE)
+
+
+def read_map(path: str | os.PathLike[str]) -> DensityMap:
+    """Read the CCP4/MRC map at ``path`` (optionally gzipped). A box is read as it lies; a
+    crystallographic map becomes its whole unit cell, periodic. Raises :class:`MapError`
+    saying why a file cannot be read."""
+    path = Path(path)
+    if not path.exists():
+        raise MapError(f"{path}: no such file")
+    if not path.is_file():
+        raise MapError(f"{path}: not a regular file (a folder, device or FIFO is not read)")
+    with path.open("rb") as raw:
+        gzipped = raw.read(2) == b"\x1f\x8b"
+    try:
+        with (gzip.open(path, "rb") if gzipped else path.open("rb")) as file:
+            return _read(file)
+    except MapError as error:
+        raise MapError(f"{path}: {error}") from None
+    except (OSError, EOFError, gzip.BadGzipFile) as error:
+        raise MapError(f"{path}: not a readable CCP4/MRC map ({error})") from None
+
+
+def _read(file: BinaryIO) -> DensityMap:
+    header = file.read(HEADER_BYTES)
+    if len(header) < HEADER_BYTES:
+        raise MapError(f"not a CCP4/MRC map: {len(header)} bytes, shorter than a map's {HEADER_BYTES}-byte header")
+    order = _byte_order(header)
+    words = np.frombuffer(header, dtype=order + "i4", count=56)
+    floats = np.frombuffer(header, dtype=order + "f4", count=56)
+    size_crs, mode, start_crs = words[0:3], int(words[3]), words[4:7]
+    sampling, cell = words[7:10].astype(np.float64), floats[10:16].astype(np.float64)
+    axis_crs = _axis_order(words[16:19])
+    spacegroup, extended = int(words[22]), int(words[23])
+    origin = floats[49:52].astype(np.float64)
+
+    if mode in (3, 4):
+        raise MapError(f"mode {mode} holds complex (Fourier) values, not a density map")
+    if mode not in MODES:
+        raise MapError(f"mode {mode} is not a mode of density values (0, 1, 2, 6 or 12)")
+    if np.prod(size_crs, dtype=np.int64) > MAX_VOXELS:
+        raise MapError(f"a grid of {' × '.join(map(str, size_crs))} voxels is larger than the {MAX_VOXELS:,} read")
+    if extended < 0:
+        raise MapError(f"the extended header's length ({extended} bytes) is negative")
+    dtype = np.dtype(MODES[mode]).newbyteorder(order)
+    count = int(np.prod(size_crs))
+    if len(file.read(extended)) < extended:
+        raise MapError("the file ends inside its extended header")
+    data = file.read(count * dtype.itemsize)
+    if len(data) < count * dtype.itemsize:
+        raise MapError(f"truncated: {len(data):,} bytes of values where its header asks for {count * dtype.itemsize:,}")
+    sections = np.frombuffer(data, dtype=dtype).reshape(size_crs[::-1])  # [section, row, column]
+
+    # To x, y, z: the array's axes are (section, row, column), lying along axes axis_crs[::-1].
+    values = np.ascontiguousarray(sections.transpose(np.argsort(axis_crs[::-1])), dtype=np.float32)
+    start = np.empty(3, dtype=np.int64)
+    start[axis_crs] = start_crs
+    finite = np.isfinite(values)
+    if not finite.any():
+        raise MapError("the map holds no finite values")
+    if not finite.all():
+        values[~finite] = values[finite].mean()
+
+    cell, sampling = _cell(cell, sampling, values.shape)
+    axes = (np.array(gemmi.UnitCell(*cell).orth.mat.tolist()) / sampling).T  # rows: the steps along x, y, z
+    corner = origin if np.any(origin != 0) and np.all(np.isfinite(origin)) else start @ axes
+    resolution = _resolution(header, words)
+    if spacegroup > 1 or np.any(values.shape < sampling):
+        whole = _unit_cell(values, start, sampling.astype(int), gemmi.UnitCell(*cell), spacegroup)
+        return DensityMap(whole, corner - start @ axes, axes, periodic=True, resolution=resolution)
+    return DensityMap(values, corner, axes, resolution=resolution)
+
+
+def _byte_order(header: bytes) -> str:
+    """``"<"`` or ``">"``: from the machine stamp (word 54), else the order in which the
+    header reads as a map."""
+    stamp = header[212]
+    if stamp in (0x44, 0x41):
+        return "<"
+    if stamp == 0x11:
+        return ">"
+    for order in ("<", ">"):
+        words = np.frombuffer(header, dtype=order + "i4", count=19)
+        if words[3] in MODES and np.all((words[:3] > 0) & (words[:3] < 2**16)) and set(words[16:19]) <= {0, 1, 2, 3}:
+            return order
+    raise MapError("not a CCP4/MRC map: its header reads as a map in neither byte order")
+
+
+def _axis_order(mapcrs: np.ndarray) -> np.ndarray:
+    """0-based spatial axes (x 0, y 1, z 2) of the columns, rows and sections."""
+    if np.all(mapcrs == 0):  # (old files leave them unset: x, y, z)
+        return np.arange(3)
+    if sorted(mapcrs.tolist()) != [1, 2, 3]:
+        raise MapError(f"its axis order MAPC, MAPR, MAPS = {', '.join(map(str, mapcrs))} is not an order of 1, 2, 3")
+    return mapcrs.astype(np.int64) - 1
+
+
+def _cell(cell: np.ndarray, sampling: np.ndarray, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The cell (a, b, c in Å, angles in degrees) and its samplings along x, y, z: a map
+    without them gets a 1 Å grid of its own size, angles of 0 are right angles (as ChimeraX
+    reads them)."""
+    sampling = np.where(sampling > 0, sampling, shape)
+    lengths = np.where((cell[:3] > 0) & np.isfinite(cell[:3]), cell[:3], sampling)
+    angles = np.where((cell[3:] > 0) & (cell[3:] < 180), cell[3:], 90.0)
+    return np.concatenate([lengths, angles]), sampling
+
+
+def _unit_cell(values: np.ndarray, start: np.ndarray, sampling: np.ndarray, cell: gemmi.UnitCell, spacegroup: int) -> np.ndarray:
+    """The whole unit cell (sampling) of a box of a periodic map that starts at ``start``:
+    the box wrapped into the cell, the rest filled from its symmetry mates in
+    ``spacegroup`` (gemmi), where none reaches with the box's mean."""
+    if np.prod(sampling, dtype=np.int64) > MAX_VOXELS:
+        raise MapError(f"a unit cell of {' × '.join(map(str, sampling))} voxels is larger than the {MAX_VOXELS:,} read")
+    whole = np.full(sampling, -np.inf, dtype=np.float32)
+    index = np.ix_(*[(s + np.arange(n)) % m for s, n, m in zip(start, values.shape, sampling)])
+    whole[index] = values
+    group = gemmi.find_spacegroup_by_number(spacegroup) if 1 < spacegroup <= 230 else None
+    if group is not None:
+        grid = gemmi.FloatGrid(whole, cell, group)
+        try:
+            grid.symmetrize_max()
+            whole = np.array(grid.array, dtype=np.float32)
+        except RuntimeError:  # a sampling the symmetry cannot map onto itself: the box alone
+            pass
+    whole[np.isneginf(whole)] = values.mean()
+    return whole
+
+
+def _resolution(header: bytes, words: np.ndarray) -> float | None:
+    """Å, where one of the header's text labels gives it ("... resolution 3.2 ...")."""
+    labels = min(max(int(words[55]), 0), 10)
+    for k in range(labels):
+        text = header[224 + 80 * k : 304 + 80 * k].decode("ascii", errors="replace")
+        if match := _RESOLUTION_LABEL.search(text):
+            value = float(match.group(1))
+            if 0.5 <= value <= 100.0:
+                return value
+    return None
