@@ -15,9 +15,9 @@ residues paired by number, in both directions.
   grid, blurred as Chimera's molmap does), the other conformation fitted into it (levels
   0-6, then regularized and refined): correlation, Cα rmsd to the target (no
   superposition: the map sets the frame) and time. Then the same into maps made another
-  way (:func:`xray_like_map`: each atom its electrons blurred by its B-factor, the Fourier
+  way (:func:`~core.fitting.simulated_maps.xray_like`: each atom its electrons blurred by its B-factor, the Fourier
   transform cut sharply at the resolution, and noise), and into gemmi's electron density
-  of the target (:func:`gemmi_map`). Anchor (published, not run here):
+  of the target (:func:`~core.fitting.simulated_maps.gemmi_like`). Anchor (published, not run here):
   iMODFIT fits GroEL (1AON into a 10 Å map of 1OEL) to 1.78 Å Cα rmsd, CC 0.982, in 244 s.
 * Every figure is the fit of the files as read, on one BLAS thread; beside it its spread
   (``--starts N``, default 3): the same fit on two BLAS threads and from N starts whose
@@ -45,17 +45,17 @@ from pathlib import Path
 import gemmi
 import numpy as np
 import prody
-from scipy import ndimage
 
 from core.analysis.superpose import superpose
 from core.fitting.conformation import fit_conformation, pair_segments
-from core.fitting.density import MapTarget, fit_map, gaussian_sigma, heavy_atoms
+from core.fitting.density import MapTarget, fit_map, heavy_atoms
+from core.fitting.simulated_maps import gemmi_like, molmap, xray_like
 from core.geometry.validation import validate
 from core.protein.model import EditableModel
 from core.protein.reading import read_structure
 from core.protein.structure import Structure, ca_rows
 from core.protein.writing import write_structure
-from core.surfaces.volume import DensityMap, model_density
+from core.surfaces.volume import DensityMap
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
 CLOSED, OPEN = "1AKE_adk_closed.pdb.gz", "4AKE_adk_open.pdb.gz"
@@ -65,7 +65,6 @@ OTHER_PAIRS = (("1TIM.pdb.gz", "8TIM.pdb.gz"), ("2AKY.pdb.gz", "1AKE.pdb.gz"), (
                ("1POH.pdb.gz", "2HPR.pdb.gz"))
 """Triosephosphate isomerase (loop 6 closed onto open), yeast into E. coli adenylate kinase,
 dihydrofolate reductase (E. coli into human) and HPr (E. coli into B. subtilis)."""
-ELECTRONS = {"C": 6, "N": 7, "O": 8, "S": 16}
 PERTURBATION = 0.001
 """Å: how far each start coordinate moves, at most, in the runs of the spread."""
 SPREAD_GOAL = 0.1
@@ -196,51 +195,6 @@ def _checks(structure: Structure, coords: np.ndarray) -> str:
             f"Ramachandran outliers {before['ramachandran']} -> {after['ramachandran']}")
 
 
-def simulated_map(structure: Structure, resolution: float) -> DensityMap:
-    """The heavy atoms on a 1 Å grid, blurred to ``resolution`` (Chimera's molmap width)."""
-    coords = structure.coords[heavy_atoms(EditableModel(structure))]
-    origin = np.floor(coords.min(axis=0)) - 15.0
-    shape = tuple(int(n) for n in np.ceil(coords.max(axis=0) + 15.0 - origin))
-    grid = np.zeros(shape)
-    np.add.at(grid, tuple(np.round(coords - origin).astype(int).T), 1.0)
-    values = ndimage.gaussian_filter(grid, gaussian_sigma(resolution)).astype(np.float32)
-    return DensityMap(values, origin, np.eye(3))
-
-
-def xray_like_map(structure: Structure, resolution: float, noise: float = 0.3, seed: int = 0) -> DensityMap:
-    """A map made another way than the fit's model density: each heavy atom a Gaussian of
-    its electrons blurred by its B-factor (σ² = B / 8π²) on a 1 Å grid, the Fourier
-    transform cut sharply at 1/``resolution`` (the ripples of a real map), and white noise
-    of ``noise`` times the map's standard deviation."""
-    rows = heavy_atoms(EditableModel(structure))
-    coords = structure.coords[rows]
-    origin = np.floor(coords.min(axis=0)) - 15.0
-    shape = tuple(int(n) for n in np.ceil(coords.max(axis=0) + 15.0 - origin))
-    grid = np.zeros(shape)
-    weight = np.array([ELECTRONS.get(e.upper(), 6) for e in structure.atoms.element[rows]], dtype=float)
-    sigma = np.sqrt(np.maximum(structure.atoms.b_factor[rows], 2.0) / (8 * np.pi**2))
-    for width in np.unique(np.round(sigma, 1)):  # atoms of like B-factor blurred together
-        layer = np.zeros(shape)
-        take = np.round(sigma, 1) == width
-        np.add.at(layer, tuple(np.round(coords[take] - origin).astype(int).T), weight[take])
-        grid += ndimage.gaussian_filter(layer, max(width, 0.3))
-    spectrum = np.fft.rfftn(grid)
-    k = np.meshgrid(*(np.fft.fftfreq(n) for n in shape[:2]), np.fft.rfftfreq(shape[2]), indexing="ij")
-    spectrum[np.sqrt(sum(f**2 for f in k)) > 1.0 / resolution] = 0.0
-    values = np.fft.irfftn(spectrum, shape, axes=(0, 1, 2))
-    values += noise * values.std() * np.random.default_rng(seed).standard_normal(shape)
-    return DensityMap(values.astype(np.float32), origin, np.eye(3))
-
-
-def gemmi_map(structure: Structure, resolution: float) -> DensityMap:
-    """A map made by another program: gemmi's electron density of the model (IT92 form
-    factors, each atom blurred by its B-factor, hydrogens included), blurred by a Gaussian
-    to ``resolution``."""
-    density = model_density(structure.atoms, spacing=1.0, margin=15.0)
-    values = ndimage.gaussian_filter(density.values, gaussian_sigma(resolution) / np.diag(density.axes))
-    return DensityMap(values.astype(np.float32), density.origin, density.axes)
-
-
 def map_fit(label: str, start: Structure, end: Structure, density: DensityMap, resolution: float) -> Outcome:
     """Fit ``start`` (its first segment) into ``density`` of ``end``: CC, Cα rmsd and time."""
     model = EditableModel(start)
@@ -267,7 +221,7 @@ def map_fit(label: str, start: Structure, end: Structure, density: DensityMap, r
 def maps(start_file: str, end_file: str, resolution: float, made: str, seed: int) -> Outcome:
     """Fit ``start_file`` (from start ``seed``) into a map of ``end_file`` made by ``made``."""
     end = read_structure(DATA / end_file)
-    density = {"molmap": simulated_map, "x-ray-like": xray_like_map, "gemmi": gemmi_map}[made](end, resolution)
+    density = {"molmap": molmap, "x-ray-like": xray_like, "gemmi": gemmi_like}[made](end, resolution)
     with tempfile.TemporaryDirectory() as scratch:
         start = started(read_structure(DATA / start_file), seed, Path(scratch))
     label = f"{start_file.split('_')[0]} into {end_file.split('_')[0]} ({made})"
@@ -305,7 +259,7 @@ def other(folder: Path, start_file: str, end_file: str, resolution: float, seed:
                                                overwrite=True))
         moved = started(moved, seed, Path(scratch))
     name = f"{start_file.split('.')[0]} into {end_file.split('.')[0]}"
-    return map_fit(name, moved, end, simulated_map(end, resolution), resolution)
+    return map_fit(name, moved, end, molmap(end, resolution), resolution)
 
 
 def main() -> None:

@@ -19,6 +19,7 @@ from core.analysis.superpose import superpose
 from core.fitting.coarse_to_fine import Pairs
 from core.fitting.conformation import SAME_FOLD, fit_conformation, fold_similarity, pair_segments
 from core.fitting.density import RESOLUTION, MapTarget, fit_map, heavy_atoms
+from core.fitting.map_quality import MapQuality, map_quality
 from core.fitting.morph import morph_frames
 from core.fitting.settle import FitResult
 from core.geometry.validation import validate
@@ -29,7 +30,7 @@ from core.surfaces.map_file import read_map
 from core.surfaces.volume import MapError
 
 DEFAULT_LEVELS = (0, 6)
-MAP_SUFFIXES = (".ccp4", ".mrc", ".map")
+MAP_SUFFIXES = (".ccp4", ".mrc", ".map", ".mtz")
 MAX_FRAMES = 1000
 CHECKED = (("peptide_bond", "bad peptide bonds"), ("ca_ca", "bad Cα–Cα"), ("clash", "clashes"),
            ("ramachandran", "Ramachandran outliers"))
@@ -57,13 +58,14 @@ def fit_arguments(parser: argparse.ArgumentParser) -> None:
     model_argument(parser)
     parser.add_argument("--to", required=True, type=Path, metavar="TARGET",
                         help="the structure to move it onto (PDB or mmCIF), or a density map to move it into "
-                             "(CCP4/MRC/MAP, optionally gzipped)")
+                             "(CCP4/MRC/MAP, optionally gzipped, or the 2mFo-DFc map of an MTZ file)")
     parser.add_argument("--chain", metavar="ID", help="chain of MODEL to fit (default: its first protein chain)")
     parser.add_argument("--target-chain", metavar="ID", help="chain of TARGET (default: its first protein chain)")
     _common_arguments(parser)
     parser.add_argument("--resolution", type=bounded(float, *RESOLUTION), metavar="Å",
-                        help="for a map target (CCP4/MRC/MAP): its resolution, which the model's density is "
-                             f"simulated at ({RESOLUTION[0]:g} to {RESOLUTION[1]:g} Å)")
+                        help="for a map target: its resolution, which the model's density is simulated at "
+                             f"({RESOLUTION[0]:g} to {RESOLUTION[1]:g} Å; default: the file's, where it gives one: "
+                             "an MTZ's high-resolution limit, a map's header label)")
     parser.add_argument("--no-regularize", dest="regularize", action="store_false",
                         help="leave the residues as the fit remaps them (peptide junctions may stretch)")
     parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
@@ -75,9 +77,14 @@ def run_fit(args: argparse.Namespace) -> int:
     structure = load(args.file, args.model)
     model = EditableModel(structure)
     before = validate(structure, model.coords).counts
-    result, report, measure, score = (_fit_map if _is_map(args.to) else _fit_structure)(model, args)
+    result, report, measure, score, judge = (_fit_map if _is_map(args.to) else _fit_structure)(model, args)
     after = validate(structure, model.coords).counts
     final = report["final"] = round(score(), 4)
+    quality = judge() if judge is not None else None
+    if quality is not None:
+        labels = [label for segment in structure.segments for label in segment.labels]
+        report["map_fit"] = {"cc_mask": round(quality.cc_mask, 4), "cc_box": round(quality.cc_box, 4),
+                             "outside_density": [labels[k] for k in quality.outside]}
     try:
         written = model.save(args.output, overwrite=args.overwrite)
     except FileExistsError as error:
@@ -113,6 +120,8 @@ def run_fit(args: argparse.Namespace) -> int:
     done = "regularized" if args.regularize else "not regularized"
     changes = ", ".join(f"{before[k]} -> {after[k]} {label}" for k, label in CHECKED)
     print(f"{done}: {name} {final:.3f}{unit}; {changes}")
+    if quality is not None:
+        print(f"the map's judgement: {quality.summary(labels)}")
     print(f"wrote {written}")
     return 0
 
@@ -122,8 +131,9 @@ def _is_map(path: Path) -> bool:
     return name.endswith(MAP_SUFFIXES)
 
 
-Fitted = tuple[FitResult, dict, str, Callable[[], float]]
-"""A settled fit, the report so far, the name of its score, and the score of the model now."""
+Fitted = tuple[FitResult, dict, str, Callable[[], float], Callable[[], MapQuality] | None]
+"""A settled fit, the report so far, the name of its score, the score of the model now, and
+for a map how well the model fits it now."""
 
 
 def _fit_structure(model: EditableModel, args: argparse.Namespace) -> Fitted:
@@ -133,12 +143,11 @@ def _fit_structure(model: EditableModel, args: argparse.Namespace) -> Fitted:
     pairs, pairing, rows = _paired(model, args.chain, target, args.target_chain, args.pairing)
     result = _settled(lambda levels: fit_conformation(model, pairs, levels, regularize=args.regularize), args.levels)
     report = {"pairing": pairing, "pairs": int(len(rows)), "what": f"{len(rows)} residue pairs ({pairing})"}
-    return result, report, "rmsd", lambda: superpose(model.coords[rows], np.concatenate([p.target for p in pairs])).rmsd
+    return result, report, "rmsd", lambda: superpose(model.coords[rows], np.concatenate([p.target for p in pairs])).rmsd, \
+        None
 
 
 def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
-    if args.resolution is None:
-        raise InputError("a map target needs --resolution (Å), the resolution to simulate the model's density at")
     if args.target_chain is not None or args.pairing != "auto":
         raise InputError("--target-chain and --pairing are for a structure target; TARGET is a map")
     structure = model.structure
@@ -148,16 +157,28 @@ def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
         raise InputError(f"{structure.path}: no protein chain to fit")
     try:
         density = read_map(args.to)
-        target = MapTarget(density, args.resolution, model.coords[heavy_atoms(model)])
+    except MapError as error:
+        raise InputError(str(error)) from None
+    resolution, source = (args.resolution, "--resolution") if args.resolution is not None else \
+        (density.resolution, "the file's")
+    if resolution is None:
+        raise InputError(f"{args.to}: the file does not give its resolution; pass --resolution (Å), the resolution "
+                         "to simulate the model's density at")
+    if not RESOLUTION[0] <= resolution <= RESOLUTION[1]:  # (only the file's can be out of range)
+        resolution, source = float(np.clip(resolution, *RESOLUTION)), f"the file's {resolution:g} Å, bounded"
+    try:
+        target = MapTarget(density, resolution, model.coords[heavy_atoms(model)])
     except (MapError, ValueError) as error:
         raise InputError(str(error)) from None
     result = _settled(lambda levels: fit_map(model, segments, target, levels, regularize=args.regularize),
                       args.levels)
     rows = heavy_atoms(model)
-    report = {"resolution": args.resolution, "segments": len(segments),
-              "what": f"{len(segments)} segment(s) into the map at {args.resolution:g} Å (each level into the map "
-                      "blurred as that level sees it)"}
-    return result, report, "cc", lambda: target.correlation(model.coords[rows])
+    report = {"resolution": round(resolution, 2), "resolution_from": source, "segments": len(segments),
+              "what": f"{len(segments)} segment(s) into the map at {resolution:.3g} Å ({source}; each level into the "
+                      "map blurred as that level sees it)"}
+    judged = rows[structure.atom_residue[rows] >= 0]  # the atoms of the chains' residues
+    return result, report, "cc", lambda: target.correlation(model.coords[rows]), \
+        lambda: map_quality(target, model.coords[judged], structure.atom_residue[judged], structure.n_residues)
 
 
 def _settled(fit: Callable[[range], FitResult], bounds: tuple[int, int]) -> FitResult:

@@ -82,6 +82,9 @@ LEVELS_RESOLUTION = 12.0
 """Å: the levels are fitted into the map blurred to this resolution at least, where it is
 finer (:meth:`MapTarget.blurred`, :func:`level_resolution`); the refinement fits into the
 map as it is."""
+CRYSTAL_MASK = 3.0
+"""Å beyond the atoms (and an atom's Gaussian width) that a crystal's map is kept around the
+model for a fit: beyond, its neighbours' density, flattened to the map's mean."""
 RESOLUTION_PER_RESIDUE = 2.0
 """Å per residue of a span between a level's control points: the resolution that level
 sees the map at (:func:`level_resolution`; coarser levels see it coarser)."""
@@ -118,12 +121,34 @@ class MapTarget:
                            f"(at least {MIN_OVERLAP:.0%} must)")
         self.origin = around.min(axis=0) - margin
         self.shape = tuple(np.ceil((around.max(axis=0) + margin - self.origin) / self.spacing).astype(int) + 1)
-        points = self.origin + np.stack(np.indices(self.shape), axis=-1).reshape(-1, 3) * self.spacing
-        values = density.interpolate(points).reshape(self.shape)
+        values = density.interpolate(self.points()).reshape(self.shape)
+        if density.periodic:  # a crystal's map: the neighbours' density off, the model fitted into its own
+            radius = CRYSTAL_MASK + self.sigma
+            inside = self.near(around, radius)
+            edge = inside & ~self.near(around, radius - 1.0)  # the solvent's level, about
+            values = np.where(inside, values, values[edge].mean())
         self._target = values - values.mean()
         self._target_norm = _norm(self._target)
         if self._target_norm == 0.0:
             raise MapError("the map is flat around the model: nothing to fit into")
+
+    @property
+    def target(self) -> np.ndarray:
+        """The map on the grid, less its mean."""
+        return self._target
+
+    def points(self) -> np.ndarray:
+        """(n, 3) the grid's points, Å, in the order of its flattened values."""
+        return self.origin + np.stack(np.indices(self.shape), axis=-1).reshape(-1, 3) * self.spacing
+
+    def near(self, coords: np.ndarray, radius: float) -> np.ndarray:
+        """Whether each grid point lies within ``radius`` Å of one of the atoms at ``coords``
+        (to half a grid step), on the grid."""
+        occupied = np.zeros(self.shape, dtype=bool)
+        index = np.round((coords - self.origin) / self.spacing).astype(int)
+        index = index[np.all((index >= 0) & (index < self.shape), axis=1)]
+        occupied[tuple(index.T)] = True
+        return ndimage.distance_transform_edt(~occupied, sampling=self.spacing) <= radius
 
     def blurred(self, resolution: float) -> MapTarget:
         """The map blurred to a coarser ``resolution`` (Å) and the model's density with it,

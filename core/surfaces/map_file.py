@@ -26,6 +26,7 @@ from typing import BinaryIO
 import gemmi
 import numpy as np
 
+from core.surfaces.map_coefficients import is_mtz, read_mtz
 from core.surfaces.volume import DensityMap, MapError
 
 MODES = {0: np.int8, 1: np.int16, 2: np.float32, 6: np.uint16, 12: np.float16}
@@ -38,7 +39,8 @@ _RESOLUTION_LABEL = re.compile(r"resolution[^0-9]{0,12}(\d+(?:\.\d+)?)", re.IGNO
 
 
 def read_map(path: str | os.PathLike[str]) -> DensityMap:
-    """Read the CCP4/MRC map at ``path`` (optionally gzipped). A box is read as it lies; a
+    """Read the CCP4/MRC map at ``path`` (optionally gzipped), or the 2mFo−DFc map of an MTZ
+    file (:func:`core.surfaces.map_coefficients.read_mtz`). A box is read as it lies; a
     crystallographic map becomes its whole unit cell, periodic. Raises :class:`MapError`
     saying why a file cannot be read."""
     path = Path(path)
@@ -46,6 +48,8 @@ def read_map(path: str | os.PathLike[str]) -> DensityMap:
         raise MapError(f"{path}: no such file")
     if not path.is_file():
         raise MapError(f"{path}: not a regular file (a folder, device or FIFO is not read)")
+    if is_mtz(path):
+        return read_mtz(path).density
     with path.open("rb") as raw:
         gzipped = raw.read(2) == b"\x1f\x8b"
     try:

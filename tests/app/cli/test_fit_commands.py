@@ -14,9 +14,11 @@ from core.fitting.density import gaussian_sigma
 from core.fitting.settle import MIN_MARGIN
 from core.protein.reading import read_structure
 from core.protein.structure import ca_rows
+from tests.conftest import D_MIN, write_mtz
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 CLOSED, OPEN = DATA / "1AKE_adk_closed.pdb.gz", DATA / "4AKE_adk_open.pdb.gz"
+UBIQUITIN = DATA / "1UBQ.pdb.gz"
 
 
 def run(capsys, *argv: object) -> tuple[int, str, str]:
@@ -125,3 +127,21 @@ def test_bad_maps_and_resolutions_are_refused(capsys, tmp_path: Path) -> None:
         main(["fit", str(CLOSED), "--to", str(density), "--resolution", "0.1", "-o", str(out)])
     assert exit_.value.code == 2
     assert "--resolution" in capsys.readouterr().err and not out.exists()
+
+
+def test_a_fit_into_an_mtz_takes_the_files_resolution_and_judges_the_model(capsys, tmp_path: Path) -> None:
+    """Ubiquitin into the 2mFo−DFc map of its own crystal (P 21 21 21, 2.5 Å): the
+    neighbours' density kept off, the model stays where it is; CC_mask, CC_box and the
+    residues outside the density are reported."""
+    mtz, out = write_mtz(tmp_path / "refined.mtz"), tmp_path / "fitted.pdb"
+    status, text, _ = run(capsys, "fit", UBIQUITIN, "--to", mtz, "-o", out, "--json")
+    assert status == 0
+    report = json.loads(text)
+    assert report["resolution"] == pytest.approx(D_MIN, abs=0.05) and report["resolution_from"] == "the file's"
+    judged = report["map_fit"]
+    assert judged["cc_mask"] > 0.8 and judged["cc_box"] > 0.8
+    assert set(judged["outside_density"]) <= {"A:LEU73", "A:ARG74", "A:GLY75", "A:GLY76"}  # B 31-36 Å²
+    before, after = read_structure(UBIQUITIN).segments[0].ca, read_structure(out).segments[0].ca
+    assert np.sqrt(np.mean(np.sum((after - before) ** 2, axis=1))) < 0.5
+    status, text, _ = run(capsys, "fit", UBIQUITIN, "--to", mtz, "-o", out, "--overwrite", "--levels", "6-6")
+    assert status == 0 and "at 2.5 Å (the file's" in text and "the map's judgement: CC_mask" in text

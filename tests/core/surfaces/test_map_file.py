@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import gzip
 import warnings
-from collections.abc import Callable
 from pathlib import Path
 
 import gemmi
@@ -18,6 +17,7 @@ import pytest
 from core.protein.reading import read_atoms
 from core.surfaces.map_file import read_map
 from core.surfaces.volume import DensityMap, MapError, model_density
+from tests.conftest import write_mrc
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 
@@ -31,30 +31,6 @@ def placed() -> tuple[DensityMap, np.ndarray]:
     step = np.diag(density.axes)
     corner = np.round(density.origin / step) * step
     return DensityMap(density.values, corner, density.axes), atoms.coords + corner - density.origin
-
-
-def write(path: Path, values_xyz: np.ndarray, *, axis_order: tuple[int, int, int] = (1, 2, 3),
-          start: tuple[int, int, int] = (0, 0, 0), origin: tuple[float, float, float] = (0.0, 0.0, 0.0),
-          sampling: tuple[int, int, int] | None = None, spacegroup: int = 1, gzipped: bool = False,
-          step: np.ndarray | None = None, dtype: type = np.float32, edit: Callable[[mrcfile.mrcfile.MrcFile], None] = lambda mrc: None) -> Path:
-    """Write ``values_xyz`` (indexed x, y, z) as ``mrcfile`` does, with columns, rows and
-    sections along the axes ``axis_order`` (MAPC, MAPR, MAPS; 1 is x), ``start`` the
-    first voxel's indices along x, y, z (written as NCSTART, NRSTART, NSSTART), ``sampling``
-    the cell's samplings along x, y, z and the cell ``step`` (Å along x, y, z, default 1) times them."""
-    columns, rows, sections = (a - 1 for a in axis_order)
-    data = np.ascontiguousarray(values_xyz.transpose(sections, rows, columns)).astype(dtype)
-    sampling = values_xyz.shape if sampling is None else sampling
-    with mrcfile.new(path, overwrite=True, compression="gzip" if gzipped else None) as mrc:
-        mrc.set_data(data)
-        header = mrc.header
-        header.mapc, header.mapr, header.maps = axis_order
-        header.nxstart, header.nystart, header.nzstart = start[columns], start[rows], start[sections]
-        header.mx, header.my, header.mz = sampling
-        header.cella = tuple((1.0 if step is None else step) * np.array(sampling, dtype=float))
-        header.origin = origin
-        header.ispg = spacegroup
-        edit(mrc)
-    return path
 
 
 def values_at_atoms(path: Path, atoms: np.ndarray) -> np.ndarray:
@@ -84,7 +60,7 @@ CONVENTIONS = {
 @pytest.mark.parametrize("convention", CONVENTIONS)
 def test_every_convention_puts_the_density_on_the_model(tmp_path: Path, placed, convention: str) -> None:
     density, atoms = placed
-    path = write(tmp_path / "map.mrc", density.values, step=step(density), **CONVENTIONS[convention](density))
+    path = write_mrc(tmp_path / "map.mrc", density.values, step=step(density), **CONVENTIONS[convention](density))
     with warnings.catch_warnings():  # (mrcfile warns of a zero machine stamp)
         warnings.simplefilter("ignore", RuntimeWarning)
         mrc = mrcfile.open(path, permissive=True)
@@ -98,7 +74,7 @@ def test_every_convention_puts_the_density_on_the_model(tmp_path: Path, placed, 
 def test_a_box_smaller_than_its_cell_repeats_with_the_cell(tmp_path: Path, placed) -> None:
     density, atoms = placed
     sampling = np.array(density.values.shape) + 17
-    path = write(tmp_path / "map.ccp4", density.values, start=start_of(density), sampling=tuple(sampling), step=step(density))
+    path = write_mrc(tmp_path / "map.ccp4", density.values, start=start_of(density), sampling=tuple(sampling), step=step(density))
     read = read_map(path)
     assert read.periodic and read.values.shape == tuple(sampling)
     lattice = step(density) * sampling * np.array([1, -2, 3])  # one lattice vector of the cell
@@ -112,7 +88,7 @@ def test_integer_and_half_precision_modes(tmp_path: Path, placed, dtype: type, m
     density, atoms = placed
     top = {np.int8: 120, np.int16: 30000, np.uint16: 60000, np.float16: 1000}[dtype]
     scaled = np.round(density.values / density.values.max() * top) if dtype is not np.float16 else density.values
-    path = write(tmp_path / "map.mrc", scaled, origin=tuple(density.origin), step=step(density), dtype=dtype)
+    path = write_mrc(tmp_path / "map.mrc", scaled, origin=tuple(density.origin), step=step(density), dtype=dtype)
     with mrcfile.open(path) as mrc:
         assert mrc.header.mode == mode
     read = read_map(path)
@@ -122,7 +98,7 @@ def test_integer_and_half_precision_modes(tmp_path: Path, placed, dtype: type, m
 def test_a_big_endian_map_with_no_machine_stamp(tmp_path: Path, placed) -> None:
     """Byte order guessed from the header, as permissive readers guess it."""
     density, atoms = placed
-    little = write(tmp_path / "little.mrc", density.values, start=start_of(density), step=step(density))
+    little = write_mrc(tmp_path / "little.mrc", density.values, start=start_of(density), step=step(density))
     raw = bytearray(little.read_bytes())
     words = np.frombuffer(bytes(raw[:1024]), dtype="<i4").copy()
     words[:56].byteswap(inplace=True)  # numbers; the 'MAP ' word (52) and labels are text
@@ -152,7 +128,7 @@ def test_an_asymmetric_unit_is_completed_by_its_symmetry(tmp_path: Path) -> None
     shape = np.array(whole.shape)
     half = whole[: shape[0] // 2 + 1, : shape[1] // 2 + 1, :]
     cell = grid.unit_cell
-    path = write(tmp_path / "asu.ccp4", half, sampling=tuple(shape), spacegroup=19,
+    path = write_mrc(tmp_path / "asu.ccp4", half, sampling=tuple(shape), spacegroup=19,
                  edit=lambda mrc: setattr(mrc.header, "cella", (cell.a, cell.b, cell.c)))
     read = read_map(path)
     assert read.periodic and read.values.shape == tuple(shape)
@@ -176,13 +152,13 @@ def test_the_resolution_in_a_header_label(tmp_path: Path, placed) -> None:
         mrc.header.label[0] = b"relion_postprocess: final resolution 3.4 Angstroms"
         mrc.header.nlabl = 1
 
-    assert read_map(write(tmp_path / "labelled.mrc", density.values, edit=label)).resolution == 3.4
-    assert read_map(write(tmp_path / "plain.mrc", density.values)).resolution is None
+    assert read_map(write_mrc(tmp_path / "labelled.mrc", density.values, edit=label)).resolution == 3.4
+    assert read_map(write_mrc(tmp_path / "plain.mrc", density.values)).resolution is None
 
 
 def test_what_cannot_be_read_is_refused_saying_why(tmp_path: Path, placed) -> None:
     density, _ = placed
-    good = write(tmp_path / "good.mrc", density.values).read_bytes()
+    good = write_mrc(tmp_path / "good.mrc", density.values).read_bytes()
 
     def refused(name: str, content: bytes, reason: str) -> None:
         path = tmp_path / name
