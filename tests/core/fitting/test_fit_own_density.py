@@ -1,0 +1,75 @@
+"""A model fitted into its own density stays where it is: ubiquitin into maps made three
+ways by other code (molmap-style, X-ray-like with its Fourier ripples and noise, gemmi's
+electron density), at 3, 6 and 10 Å, in tight and loose boxes, and into maps written by
+mrcfile in every convention of the CCP4/MRC format, read back from the file.
+
+The bound is 0.5 Å of Cα rmsd, except at 10 Å in the maps made with B-factors and
+electrons (X-ray-like, gemmi's), where the fit moves the model 0.7-1.0 Å today, a known gap:
+there the bound is 1.1 Å."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.fitting.density import MapTarget, fit_map, heavy_atoms
+from core.fitting.simulated_maps import gemmi_like, molmap, xray_like
+from core.geometry.validation import validate
+from core.protein.model import EditableModel
+from core.protein.reading import read_structure
+from core.protein.structure import Structure, ca_rows
+from core.protein.writing import write_structure
+from core.surfaces.map_file import read_map
+from core.surfaces.volume import DensityMap
+from tests.conftest import write_mrc
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+LEVELS = range(0, 7)
+MAKERS = {"molmap": molmap, "x-ray-like": xray_like, "gemmi": gemmi_like}
+BOXES = {"tight": 3.0, "loose": 15.0}
+"""Å of box around the atoms."""
+
+
+def fitted_moves(structure: Structure, density: DensityMap, resolution: float) -> float:
+    """Fit ``structure`` into ``density`` as ``ribbonwave fit`` does; the Cα rmsd from where
+    it was, Å. No geometry check may get worse."""
+    model, ca = EditableModel(structure), ca_rows(structure)
+    start = model.coords[ca].copy()
+    fit_map(model, [0], MapTarget(density, resolution, model.coords[heavy_atoms(model)]), LEVELS)
+    before, after = validate(structure).counts, validate(structure, model.coords).counts
+    assert all(after[kind] <= before[kind] for kind in ("peptide_bond", "ca_ca", "ramachandran"))
+    return float(np.sqrt(np.mean(np.sum((model.coords[ca] - start) ** 2, axis=1))))
+
+
+@pytest.fixture(scope="module")
+def ubiquitin() -> Structure:
+    return read_structure(DATA / "1UBQ.pdb.gz")
+
+
+@pytest.mark.parametrize("box", BOXES)
+@pytest.mark.parametrize("resolution", [3.0, 6.0, 10.0])
+@pytest.mark.parametrize("made", MAKERS)
+def test_a_model_stays_in_its_own_density(ubiquitin: Structure, made: str, resolution: float, box: str) -> None:
+    density = MAKERS[made](ubiquitin, resolution, margin=BOXES[box])
+    bound = 1.1 if resolution == 10.0 and made != "molmap" else 0.5
+    assert fitted_moves(ubiquitin, density, resolution) < bound
+
+
+@pytest.mark.parametrize("convention", ["origin", "start", "axes-312-start", "cell-larger-than-box", "machine-stamp-0",
+                                        "gzipped"])
+def test_a_model_stays_in_its_own_density_written_by_mrcfile(ubiquitin: Structure, tmp_path: Path,
+                                                             convention: str) -> None:
+    density = gemmi_like(ubiquitin, 6.0, margin=BOXES["tight"])
+    step = np.diag(density.axes)
+    corner = np.round(density.origin / step).astype(int)
+    moved = density.origin - corner * step  # the model moved onto the grid the header can say
+    start = tuple(corner.tolist())
+    options = {"origin": {"origin": tuple(corner * step)},
+               "start": {"start": start},
+               "axes-312-start": {"axis_order": (3, 1, 2), "start": start},
+               "cell-larger-than-box": {"start": start, "sampling": tuple(np.array(density.values.shape) + 11)},
+               "machine-stamp-0": {"start": start, "edit": lambda mrc: mrc.header.machst.fill(0)},
+               "gzipped": {"origin": tuple(corner * step), "gzipped": True}}[convention]
+    path = write_mrc(tmp_path / "ubiquitin.mrc", density.values, step=step, **options)
+    shifted = read_structure(write_structure(ubiquitin, ubiquitin.coords - moved, tmp_path / "shifted.pdb"))
+    assert fitted_moves(shifted, read_map(path), 6.0) < 0.5
