@@ -10,8 +10,10 @@ fit settles as on the command line (:func:`core.fitting.settle.settle`): the res
 moved are regularized as after a drag, one more step, and where that leaves more bad
 peptide junctions than the file had, the finest level's step is undone and the rest
 regularized again. A map fit is then refined (:func:`core.fitting.density.refine`: every
-residue moved into the map on its own, its side chains turning), one more step. Cancel undoes
-the level under way and keeps the steps done.
+residue moved into the map on its own, its side chains turning), one more step. The progress
+dialog covers every stage. Cancel never leaves broken geometry: during the levels, whose
+steps are not yet regularized, it undoes the whole fit; during the regularization it keeps
+the pass done, regularized; during the refinement, the residues refined so far, regularized.
 """
 
 from __future__ import annotations
@@ -97,8 +99,9 @@ def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent
     one undo step; after more than one level (not cancelled), settle and refine as the
     module says, a step each. Shows a window-modal progress dialog with Cancel. Returns the
     levels kept."""
-    progress = QProgressDialog(f"Fitting to the {target.name} at level {levels[0]}…", "Cancel", 0, len(levels),
-                               parent)
+    settles = len(levels) > 1
+    stages = len(levels) + (1 + (target.refine is not None) if settles else 0)
+    progress = QProgressDialog(f"Fitting to the {target.name} at level {levels[0]}…", "Cancel", 0, stages, parent)
     progress.setWindowTitle(f"Fit to {target.name}")
     progress.setWindowModality(Qt.WindowModality.WindowModal)
     progress.setMinimumDuration(0)
@@ -113,6 +116,7 @@ def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent
             document.undo_stack.undo()
 
     kept: list[LevelFit] = []
+    before = document.undo_stack.index()
     try:
         for fit in target.fits(levels, cancelled):
             if progress.wasCanceled():  # cut short: undone
@@ -127,7 +131,10 @@ def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent
             if len(kept) < len(levels):
                 progress.setLabelText(f"Level {fit.level}: {target.score(fit)}. Fitting at level "
                                       f"{levels[len(kept)]}…")
-        if len(levels) > 1 and kept and not progress.wasCanceled():
+        if progress.wasCanceled():  # the levels kept are not regularized: the fit is undone
+            document.undo_stack.setIndex(before)
+            return []
+        if settles and kept:
             kept = _settle(document, target, kept, progress, cancelled, undo)
     finally:
         progress.close()
@@ -144,9 +151,13 @@ def _settle(document: Document, target: FitTarget, fits: list[LevelFit], progres
     undone = f" (level {', '.join(map(str, result.dropped))} undone: bad junctions, Ramachandran outliers)" if result.dropped else ""
     if result.regularization:
         document.push_applied(result.regularization, f"Regularize the fit to {target.name}{undone}")
+    progress.setValue(progress.value() + 1)
     if target.refine is not None and result.levels and not progress.wasCanceled():
-        progress.setLabelText(f"Refining each residue into the {target.name}…")
-        refined = target.refine(cancelled)
+        progress.setLabelText(f"Refining each residue into the {target.name} (Cancel keeps the residues refined so "
+                              "far, regularized)…")
+        QApplication.processEvents()
+        refined = target.refine(cancelled)  # (regularized, also when cancelled)
         if refined:
             document.push_applied(refined, f"Refine the fit to {target.name} (each residue, side chains)")
+        progress.setValue(progress.value() + 1)
     return result.levels

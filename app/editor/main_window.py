@@ -33,6 +33,7 @@ from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
     QFileDialog,
+    QInputDialog,
     QLabel,
     QLineEdit,
     QMainWindow,
@@ -90,7 +91,7 @@ STRUCTURE_FILTER = "Structures (*.pdb *.ent *.cif *.mmcif *.gz);;All files (*)"
 SAVE_FILTERS = {"PDB (*.pdb *.pdb.gz *.ent)": ".pdb", "mmCIF (*.cif *.cif.gz *.mmcif)": ".cif"}
 SAVE_SUFFIXES = (".pdb", ".ent", ".cif", ".mmcif", ".pdb.gz", ".ent.gz", ".cif.gz", ".mmcif.gz")
 SESSION_FILTER = f"ribbonwave sessions (*{session.SUFFIX});;All files (*)"
-MAP_FILTER = "Density maps (*.ccp4 *.mrc *.map *.gz);;All files (*)"
+MAP_FILTER = "Density maps and map coefficients (*.ccp4 *.mrc *.map *.mtz *.gz);;All files (*)"
 
 
 class MainWindow(QMainWindow):
@@ -145,6 +146,8 @@ class MainWindow(QMainWindow):
         self.console = PythonConsole({"rw": self.rw, "np": np})
         self.sequence_bar = SequenceBar(self.document)
         self.sequence_bar.strip.residuesActivated.connect(self.select_and_centre)
+        self.correlation.judged.connect(lambda: self.sequence_bar.strip.set_scores(
+            None if self.correlation.quality is None else self.correlation.quality.residues))
         # the right column runs from the toolbar to the status bar; the sequence bar spans the view only
         self.setCorner(Qt.Corner.TopRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
         self.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
@@ -360,11 +363,29 @@ class MainWindow(QMainWindow):
         """Centre the view on ``flag``'s marker and select its residues (see :meth:`select_and_centre`)."""
         self.select_and_centre(np.array(flag.residues, dtype=np.int64), np.array(flag.position))
 
-    def open_map(self, path: Path, *, raise_errors: bool = False) -> bool:
-        """Show the density map at ``path`` (CCP4/MRC, optionally gzipped); a bad file is
-        reported in a dialog (or raised as MapError with ``raise_errors``)."""
+    def open_map(self, path: Path, columns: tuple[str, str] | None = None, *, raise_errors: bool = False) -> bool:
+        """Show the density map at ``path`` (CCP4/MRC, optionally gzipped), or an MTZ file's
+        2mFo−DFc and mFo−DFc maps (of ``columns``, amplitude and phase, else as Coot finds
+        them; where it finds none, the user chooses a pair). A bad file is reported in a
+        dialog (or raised as MapError with ``raise_errors``)."""
+        from core.surfaces.map_coefficients import column_pairs, is_mtz
+
         try:
-            self.maps.open(Path(path))
+            try:
+                self.maps.open(Path(path), columns)
+            except ValueError:
+                if raise_errors or columns is not None or not Path(path).is_file() or not is_mtz(path):
+                    raise
+                pairs = column_pairs(path)
+                if not pairs:
+                    raise
+                names = [f"{f}, {phi}" for f, phi in pairs]
+                name, chosen = QInputDialog.getItem(self, "Map Coefficients", f"{Path(path).name} has no columns named "
+                                                    "as refinement names 2mFo−DFc. Amplitude and phase:", names, 0,
+                                                    False)
+                if not chosen:
+                    return False
+                self.maps.open(Path(path), pairs[names.index(name)])
         except ValueError as error:  # a MapError
             if raise_errors:
                 raise
@@ -397,7 +418,14 @@ class MainWindow(QMainWindow):
             return []
         if levels is None:
             levels = levels_to_fit(document, coarse_to_fine)
-        return run_fit(document, fit_target, levels, self)
+        kept = run_fit(document, fit_target, levels, self)
+        if target == "map" and kept:
+            self.correlation.judge()  # now, not after the edits' pause
+            quality = self.correlation.quality
+            if quality is not None:
+                labels = list(document.structure.segments[document.segment].labels)
+                self.statusBar().showMessage(f"Fitted to the map: {quality.summary(labels)}", 30000)
+        return kept
 
     def _compared(self) -> Compared:
         """The compared structure fits go to: the first shown (else the first)."""

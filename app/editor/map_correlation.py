@@ -1,9 +1,16 @@
-"""The live correlation of the edited segment with the open map.
+"""The live correlation of the edited segment with the open map, and its judgement.
 
 The segment's heavy atoms, blurred to the map's resolution, are correlated with the map in
 a box around them (:class:`core.fitting.density.MapTarget`, built again when the segment,
 the map or the resolution changes). Edits (a drag's previews included) ask for a new value;
-it is computed between events, at most every :data:`INTERVAL_MS`.
+it is computed between events, at most every :data:`INTERVAL_MS`. Once the edits pause for
+:data:`JUDGE_MS`, the segment is judged as a modeller judges a fit
+(:func:`core.fitting.map_quality.map_quality`: CC_mask, CC_box, each residue's CC, the
+residues outside the density).
+
+The resolution is the file's where it gives one (an MTZ's high-resolution limit, a map's
+header label), bounded to what the fits take; else :data:`DEFAULT_RESOLUTION`, said to be
+a guess until the user sets it.
 """
 
 from __future__ import annotations
@@ -19,9 +26,12 @@ from app.editor.scene.map_mesh import MapMesh
 
 if TYPE_CHECKING:
     from core.fitting.density import MapTarget
+    from core.fitting.map_quality import MapQuality
 
 INTERVAL_MS = 100
 """Shortest time between two correlations."""
+JUDGE_MS = 400
+"""The edits' pause after which the segment is judged."""
 DEFAULT_RESOLUTION = 5.0
 """Å, the map's resolution until it is set."""
 
@@ -31,6 +41,8 @@ class LiveCorrelation(QObject):
 
     updated = Signal()
     """:attr:`value` or :attr:`message` changed."""
+    judged = Signal()
+    """:attr:`quality` changed."""
 
     def __init__(self, document: Document, maps: MapMesh) -> None:
         super().__init__(document)
@@ -38,6 +50,10 @@ class LiveCorrelation(QObject):
         self.maps = maps
         self.resolution = DEFAULT_RESOLUTION
         """Å: the model's density is blurred to it (as the fits do)."""
+        self.resolution_source = "a guess: set it"
+        """Where :attr:`resolution` comes from, for people."""
+        self.quality: MapQuality | None = None
+        """The segment's fit in the map (see :func:`core.fitting.map_quality.map_quality`), or None."""
         self.value: float | None = None
         """The CC, or None without a map (or where it cannot be computed: see :attr:`message`)."""
         self.message = ""
@@ -50,8 +66,12 @@ class LiveCorrelation(QObject):
         self._timer.setSingleShot(True)
         self._timer.setTimerType(Qt.TimerType.PreciseTimer)
         self._timer.timeout.connect(self.update)
+        self._judge_timer = QTimer(self)
+        self._judge_timer.setSingleShot(True)
+        self._judge_timer.timeout.connect(self.judge)
         for signal in (document.loaded, document.changed, document.segmentChanged, maps.changed):
             signal.connect(self._schedule)
+        maps.opened.connect(self._map_opened)
 
     def set_resolution(self, resolution: float) -> None:
         """The map's resolution, Å (in :data:`core.fitting.density.RESOLUTION`, else ValueError)."""
@@ -59,8 +79,37 @@ class LiveCorrelation(QObject):
 
         if not RESOLUTION[0] <= resolution <= RESOLUTION[1]:
             raise ValueError(f"resolution must be in [{RESOLUTION[0]:g}, {RESOLUTION[1]:g}] Å; got {resolution:g}")
-        self.resolution = float(resolution)
+        self.resolution, self.resolution_source = float(resolution), "set"
         self.update()
+        self._judge_timer.start(JUDGE_MS)
+
+    def judge(self) -> None:
+        """Judge the edited segment's fit in the map now (:attr:`quality`; None without one)."""
+        from core.fitting.map_quality import map_quality
+
+        self._judge_timer.stop()
+        quality, document = None, self.document
+        if self.maps.density is not None and document.editable:
+            try:
+                target = self._segment_target()
+            except ValueError:
+                target = None
+            if target is not None:
+                segment = document.structure.segments[document.segment]
+                residue = document.structure.atom_residue[self._rows] - int(segment.residue_index[0])
+                quality = map_quality(target, document.model.coords[self._rows], residue, len(segment))
+        self.quality = quality
+        self.judged.emit()
+
+    def _map_opened(self) -> None:
+        from core.fitting.density import RESOLUTION
+
+        given = self.maps.density.resolution
+        if given is None:
+            self.resolution_source = "not given by the file: set it"
+            return
+        self.resolution = float(np.clip(given, *RESOLUTION))
+        self.resolution_source = "the file's" if self.resolution == given else f"the file's {given:.3g} Å, bounded"
 
     def update(self) -> None:
         """Correlate now."""
@@ -103,6 +152,9 @@ class LiveCorrelation(QObject):
         if self.maps.density is None:
             if self.value is not None or self.message:
                 self.update()
+            if self.quality is not None:
+                self.judge()
             return
         if not self._timer.isActive():
             self._timer.start(int(np.ceil(max(0.0, INTERVAL_MS - 1000.0 * (time.perf_counter() - self._last)))))
+        self._judge_timer.start(JUDGE_MS)

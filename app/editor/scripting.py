@@ -173,10 +173,12 @@ class EditorAPI:
         else:
             self._window.open_file(path, raise_errors=True)
 
-    def open_map(self, path: str | Path) -> None:
-        """Show a density map (CCP4/MRC, optionally gzipped) as File ▸ Open Map… does
-        (raises :class:`core.surfaces.volume.MapError` for a file that is not one)."""
-        self._window.open_map(Path(path), raise_errors=True)
+    def open_map(self, path: str | Path, columns: tuple[str, str] | None = None) -> None:
+        """Show a density map (CCP4/MRC, optionally gzipped), or an MTZ file's maps (of
+        ``columns``, amplitude and phase, else those refinement names 2mFo−DFc and mFo−DFc),
+        as File ▸ Open Map… does (raises :class:`core.surfaces.volume.MapError` for a file
+        that is not one)."""
+        self._window.open_map(Path(path), columns, raise_errors=True)
 
     def export(self, path: str | Path, *, overwrite: bool = False) -> Path:
         """Write the structure as edited (PDB or mmCIF by the extension) without making

@@ -2,7 +2,9 @@
 
 Each residue is a cell coloured by secondary structure, numbered every ten residues; the
 residues the picked control point moves are underlined in the pick's colour and the
-selected ones framed in the selection's colour. A click (or a drag across cells) asks for
+selected ones framed in the selection's colour. With a map open, a thin bar over each cell
+gives the residue's correlation with the map (red 0.3 or less, through yellow, to green 0.8
+or more; grey where it has none). A click (or a drag across cells) asks for
 those residues to be selected and centred (:attr:`SequenceBar.residuesActivated`, which the
 window connects); Shift extends the selection. Hovering names the residue.
 """
@@ -39,6 +41,8 @@ class SequenceStrip(QWidget):
         self.row_height = metrics.height() + 4
         self.setMouseTracking(True)
         self._anchor: int | None = None
+        self.scores: np.ndarray | None = None
+        """Each residue's correlation with the map (NaN where none), or None without a map."""
         for signal in (document.loaded, document.segmentChanged, document.picked, document.selectionChanged):
             signal.connect(self._refresh)
         self._refresh()
@@ -57,6 +61,11 @@ class SequenceStrip(QWidget):
         """The residue (index within the segment) at ``x`` pixels, or None."""
         k = (x - 4) // self.cell
         return int(k) if 0 <= k < self._count() and x >= 4 else None
+
+    def set_scores(self, scores: np.ndarray | None) -> None:
+        """Show each residue's correlation with the map (``None``: no map)."""
+        self.scores = None if scores is None else np.asarray(scores, dtype=np.float64)
+        self.update()
 
     def _count(self) -> int:
         document = self.document
@@ -86,6 +95,8 @@ class SequenceStrip(QWidget):
         for k in range(first, last):
             cell = self.cell_rect(k)
             painter.fillRect(cell, QColor(*_light(SS_COLOURS[segment.ss[k]])))
+            if self.scores is not None and k < len(self.scores):
+                painter.fillRect(QRect(cell.left(), cell.top(), cell.width(), 3), _score_colour(self.scores[k]))
             if moved[k]:
                 painter.fillRect(QRect(cell.left(), cell.bottom() - 2, cell.width(), 3), QColor(*PICKED_COLOUR))
             if selected[k]:
@@ -115,8 +126,10 @@ class SequenceStrip(QWidget):
             self._activate(self._anchor, residue)
             return
         segment = self.document.structure.segments[self.document.segment]
-        QToolTip.showText(event.globalPosition().toPoint(),
-                          f"{segment.labels[residue]} · {SS_NAMES[segment.ss[residue]]}", self)
+        text = f"{segment.labels[residue]} · {SS_NAMES[segment.ss[residue]]}"
+        if self.scores is not None and residue < len(self.scores) and np.isfinite(self.scores[residue]):
+            text += f" · map CC {self.scores[residue]:.2f}"
+        QToolTip.showText(event.globalPosition().toPoint(), text, self)
 
     def _activate(self, a: int, b: int) -> None:
         start = int(self.document.structure.segments[self.document.segment].residue_index[0])
@@ -150,6 +163,13 @@ class SequenceBar(QScrollArea):
         if len(rows):
             cell = self.strip.cell_rect(int(rows[0]))
             self.ensureVisible(cell.center().x(), cell.center().y(), 3 * self.strip.cell, 0)
+
+
+def _score_colour(cc: float) -> QColor:
+    """Red at CC 0.3 or less, yellow at 0.55, green at 0.8 or more; grey for NaN."""
+    if not np.isfinite(cc):
+        return QColor(160, 160, 160)
+    return QColor.fromHsvF(float(np.clip((cc - 0.3) / 0.5, 0.0, 1.0)) / 3.0, 0.85, 0.9)
 
 
 def _light(rgb: tuple[int, int, int]) -> tuple[int, int, int]:

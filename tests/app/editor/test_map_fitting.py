@@ -14,6 +14,7 @@ from pathlib import Path
 import gemmi
 import numpy as np
 import pytest
+from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication, QFileDialog, QProgressDialog
 from pytestqt.qtbot import QtBot
 from scipy import ndimage
@@ -209,7 +210,9 @@ def test_a_fit_moves_every_segment_of_the_edited_chain_in_one_step_a_level(
     assert np.array_equal(document.model.coords, structure.coords)
 
 
-def test_cancel_stops_the_fit_after_the_level_under_way(window: MainWindow, qtbot: QtBot) -> None:
+def test_cancel_during_the_levels_undoes_the_whole_fit(window: MainWindow, qtbot: QtBot) -> None:
+    """The levels' steps are not regularized yet: a Cancel among them leaves the model as it
+    was, never with stretched junctions."""
     document = window.document
     document.set_level(3)
 
@@ -221,10 +224,31 @@ def test_cancel_stops_the_fit_after_the_level_under_way(window: MainWindow, qtbo
     document.undo_stack.indexChanged.connect(cancel)
     window.fit_actions[1].trigger()  # Edit ▸ Fit to Map Coarse to Fine
     document.undo_stack.indexChanged.disconnect(cancel)
-    steps, index = window.rw.history()
-    assert index == 1 and steps[0].startswith("Fit to map at level 0")
-    window.rw.undo()
+    assert window.rw.history()[1] == 0
     assert np.array_equal(document.model.coords, document.structure.coords)
+
+
+def test_cancel_during_the_refinement_keeps_a_regularized_model(window: MainWindow, qtbot: QtBot) -> None:
+    """The progress dialog stays up through the regularization and the refinement; a Cancel
+    in the refinement keeps the residues refined so far, regularized: no junction broken."""
+    document = window.document
+    document.set_level(3)
+    seen: list[tuple[bool, int, int]] = []
+
+    def regularized() -> None:
+        if document.undo_stack.text(document.undo_stack.index() - 1).startswith("Regularize"):
+            dialog = window.findChild(QProgressDialog)
+            seen.append((dialog.isVisible(), dialog.value(), dialog.maximum()))
+            QTimer.singleShot(400, dialog.cancel)  # in the middle of the refinement
+
+    document.undo_stack.indexChanged.connect(regularized)
+    window.fit_actions[1].trigger()
+    document.undo_stack.indexChanged.disconnect(regularized)
+    assert seen and seen[0][0] and seen[0][1] < seen[0][2]  # the dialog still up, the refinement to come
+    steps, index = window.rw.history()
+    assert steps[index - 1].startswith(("Refine the fit", "Regularize the fit"))
+    before, after = validate(document.structure).counts, validate(document.structure, document.model.coords).counts
+    assert after["peptide_bond"] <= before["peptide_bond"] + 2 and after["clash"] <= before["clash"] + 5
 
 
 def test_fit_to_compared_structure_brings_the_ca_rmsd_down(open_window: Callable[[str], MainWindow]) -> None:
