@@ -25,6 +25,12 @@ residues paired by number, in both directions.
   their own (``--jobs``). The spread is the largest Cα rmsd between any two of the fitted
   models, and the range of the figure over them (#31: a fit is converged when that spread
   stays within 0.1 Å).
+* ``--large DIR``: large domain motions (:data:`LARGE_MOTIONS`), made from entries of DIR:
+  the smaller of the chain's two dynamic domains (the sign of the slowest mode of ProDy's
+  Gaussian network model) turned rigidly by an angle about an axis through the hinge (the
+  residues of the other domain nearest it) perpendicular to the line between the domains;
+  the chain as read fitted into a 10 Å molmap map of the turned one. Printed beside
+  iMODFIT's figure for GroEL (1.78 Å, 244 s), the goal 2.0 Å (#32).
 * ``--others DIR``: the same for other pairs of conformations or homologues, files of DIR
   (:data:`OTHER_PAIRS`, chain A of each), the start first placed on the target by its
   paired Cα (as a rigid fit would place it), the Cα rmsd over the paired residues.
@@ -35,6 +41,8 @@ from __future__ import annotations
 import argparse
 import multiprocessing
 import os
+import shutil
+import subprocess
 import tempfile
 import time
 from collections.abc import Callable, Sequence
@@ -45,6 +53,8 @@ from pathlib import Path
 import gemmi
 import numpy as np
 import prody
+from scipy import ndimage
+from scipy.spatial.transform import Rotation
 
 from core.analysis.superpose import superpose
 from core.fitting.conformation import fit_conformation, pair_segments
@@ -53,6 +63,7 @@ from core.fitting.simulated_maps import gemmi_like, molmap, xray_like
 from core.geometry.validation import validate
 from core.protein.model import EditableModel
 from core.protein.reading import read_structure
+from core.protein.secondary_structure import dssp
 from core.protein.structure import Structure, ca_rows
 from core.protein.writing import write_structure
 from core.surfaces.volume import DensityMap
@@ -65,6 +76,11 @@ OTHER_PAIRS = (("1TIM.pdb.gz", "8TIM.pdb.gz"), ("2AKY.pdb.gz", "1AKE.pdb.gz"), (
                ("1POH.pdb.gz", "2HPR.pdb.gz"))
 """Triosephosphate isomerase (loop 6 closed onto open), yeast into E. coli adenylate kinase,
 dihydrofolate reductase (E. coli into human) and HPr (E. coli into B. subtilis)."""
+LARGE_MOTIONS = (("1ANF.pdb.gz", 35.0), ("1ANF.pdb.gz", 60.0), ("2D0F.pdb.gz", 40.0))
+"""Maltodextrin-binding protein (370 residues, its C-terminal domain turned 35° and 60°) and
+α-amylase (637 residues, 40°): a file and the angle its smaller domain turns."""
+GOAL_LARGE = 2.0
+"""Å of Cα rmsd to the target that a large motion's fit should reach (#32)."""
 PERTURBATION = 0.001
 """Å: how far each start coordinate moves, at most, in the runs of the spread."""
 SPREAD_GOAL = 0.1
@@ -195,10 +211,84 @@ def _checks(structure: Structure, coords: np.ndarray) -> str:
             f"Ramachandran outliers {before['ramachandran']} -> {after['ramachandran']}")
 
 
+JUDGES = ("king-probe", "mkdssp")
+"""Independent judges of a model's geometry, from Debian's packages king-probe and dssp."""
+
+
+def judges(models: dict[str, tuple[Structure, np.ndarray]]) -> str:
+    """Each model (name: its structure and coordinates) as the independent judges see it
+    beside the project's own counts: king-probe's clashscore (MolProbity's serious overlaps,
+    0.4 Å or more, per 1,000 atoms; heavy atoms only, no hydrogens added) and clashes per
+    1,000 atoms of :func:`core.geometry.validation.validate`; helix and strand residues by
+    mkdssp and by :func:`core.protein.secondary_structure.dssp`, and the share of residues
+    whose state is the last model's."""
+    missing = [tool for tool in JUDGES if shutil.which(tool) is None]
+    if missing:
+        return f"  judges: {', '.join(missing)} not installed (apt install king-probe dssp)"
+    parts, states = [], {}
+    with tempfile.TemporaryDirectory() as scratch:
+        for name, (structure, coords) in models.items():
+            pdb, heavy = _for_judges(structure, coords, Path(scratch) / name)
+            probe = subprocess.run(["king-probe", "-u", "-q", "-mc", "-het", "-once", "-NOVDWOUT", "ogt0 not water",
+                                    "ogt0", str(pdb)], capture_output=True, text=True, check=False).stdout
+            fields = [line.split(":") for line in probe.splitlines() if line.count(":") > 6]
+            pairs = {(f[3], f[4]) for f in fields if f[2] in ("so", "bo") and float(f[5]) <= -0.4}
+            theirs = _mkdssp(pdb, Path(scratch) / f"{name}.dssp")
+            ours = _own_ss(structure, coords)
+            states[name] = theirs, ours
+            own_clashes = validate(structure, coords).counts["clash"] * 1000.0 / structure.n_atoms
+            parts.append(f"{name} clashscore {1000.0 * len(pairs) / heavy:.1f} (own {own_clashes:.1f}), H/E "
+                         f"{np.sum(theirs == 'H')}/{np.sum(theirs == 'E')} (own {np.sum(ours == 'H')}/{np.sum(ours == 'E')})")
+    last_theirs, last_ours = states[list(models)[-2]] if len(models) > 2 else states[list(models)[0]]
+    fitted_theirs, fitted_ours = states[list(models)[-1]]
+    same = (f"; secondary structure as the target's: mkdssp {np.mean(fitted_theirs == last_theirs):.0%}, own "
+            f"{np.mean(fitted_ours == last_ours):.0%}" if len(fitted_theirs) == len(last_theirs) else "")
+    return "  judges: " + "; ".join(parts) + same
+
+
+def _for_judges(structure: Structure, coords: np.ndarray, stem: Path) -> tuple[Path, int]:
+    """The model's heavy atoms written by gemmi as PDB for king-probe and mkdssp, and their count."""
+    st = gemmi.read_structure(str(write_structure(structure, coords, stem.with_suffix(".in.pdb"), overwrite=True)))
+    atoms = [atom for chain in st[0] for residue in chain for atom in residue]
+    for atom, element in zip(atoms, structure.atoms.element, strict=True):  # (as read here: gemmi guesses otherwise
+        atom.element = gemmi.Element(element)                              # from names out of their columns)
+    for chain in st[0]:
+        chain.name = chain.name.strip() or "A"
+    st.remove_hydrogens()
+    st.raw_remarks = []  # (mkdssp refuses free-text REMARK lines, and wants a HEADER first)
+    pdb = stem.with_suffix(".pdb")
+    text = st.make_pdb_string()
+    pdb.write_text(text if text.startswith("HEADER") else f"{'HEADER':<80}\n" + text)
+    return pdb, sum(len(residue) for chain in st[0] for residue in chain)
+
+
+def _mkdssp(path: Path, out: Path) -> np.ndarray:
+    """mkdssp's H (H, G, I), E (E, B) or C per residue of ``path``."""
+    subprocess.run(["mkdssp", "--output-format", "dssp", str(path), str(out)], capture_output=True, check=False)
+    lines = out.read_text().splitlines() if out.exists() else []
+    start = next((k for k, line in enumerate(lines) if line.startswith("  #  RESIDUE")), len(lines))
+    codes = [line[16] for line in lines[start + 1:] if len(line) > 16 and line[13] != "!"]
+    return np.array(["H" if c in "HGI" else "E" if c in "EB" else "C" for c in codes])
+
+
+def _own_ss(structure: Structure, coords: np.ndarray) -> np.ndarray:
+    """The project's H, E or C per residue of every segment at ``coords``."""
+    names, xyz, starts = structure.atoms.name, [], []
+    for segment in structure.segments:
+        for k in range(len(segment)):
+            rows = segment.atoms(k)
+            found = [np.flatnonzero(names[rows] == atom) for atom in ("N", "CA", "C", "O")]
+            xyz.append([coords[rows.start + hit[0]] if len(hit) else np.full(3, np.nan) for hit in found])
+            starts.append(k == 0)
+    xyz = np.array(xyz)
+    proline = np.concatenate([segment.resname == "PRO" for segment in structure.segments])
+    return dssp(*xyz.transpose(1, 0, 2), chain_start=np.array(starts), proline=proline, helix_caps=True)
+
+
 def map_fit(label: str, start: Structure, end: Structure, density: DensityMap, resolution: float) -> Outcome:
     """Fit ``start`` (its first segment) into ``density`` of ``end``: CC, Cα rmsd and time."""
     model = EditableModel(start)
-    pairs, _ = pair_segments(model, [0], [end.segments[0]])
+    pairs, _ = pair_segments(model, [0], list(end.segments))  # (the target's chain may be broken)
     rows, target_ca = ca_rows(start)[start.segments[0].residue_index[pairs[0].residues]], pairs[0].target
     target = MapTarget(density, resolution, model.coords[heavy_atoms(model)])
     heavy = heavy_atoms(model)
@@ -214,7 +304,8 @@ def map_fit(label: str, start: Structure, end: Structure, density: DensityMap, r
     dropped = f", level {', '.join(map(str, result.dropped))} undone" if result.dropped else ""
     levels = ", ".join(f"{f.level}: {f.score:.3f}" for f in result.levels)
     text = (f"  {label} at {resolution:>4g} Å: CC {first[0]:.3f} -> {cc:.3f}, Cα rmsd {first[1]:.2f} -> {final:.2f} Å "
-            f"({len(rows)} Cα), {seconds:.1f} s (levels {levels}{dropped})")
+            f"({len(rows)} Cα), {seconds:.1f} s (levels {levels}{dropped})\n"
+            + judges({"input": (start, start.coords), "target": (end, end.coords), "fitted": (start, model.coords)}))
     return Outcome(model.coords[rows].copy(), {"CC": cc, "Cα rmsd": final}, text)
 
 
@@ -262,9 +353,46 @@ def other(folder: Path, start_file: str, end_file: str, resolution: float, seed:
     return map_fit(name, moved, end, molmap(end, resolution), resolution)
 
 
+def turned(structure: Structure, angle: float, folder: Path) -> tuple[Structure, int]:
+    """``structure`` with its smaller dynamic domain turned by ``angle`` degrees about its
+    hinge (see ``--large``), and the domain's size in residues."""
+    ca = structure.coords[ca_rows(structure)[structure.segments[0].residue_index]]
+    gnm = prody.GNM()
+    gnm.buildKirchhoff(ca, cutoff=7.3)
+    gnm.calcModes(1)
+    sign = np.sign(gnm.getEigvecs()[:, 0])
+    small = sign == (1.0 if np.sum(sign > 0) < np.sum(sign < 0) else -1.0)
+    small = ndimage.median_filter(small, size=15, mode="nearest")  # no stray pieces: the chain crosses few times
+    nearest = np.linalg.norm(ca[~small][:, None] - ca[small][None], axis=2).min(axis=1)
+    hinge = ca[~small][np.argsort(nearest)[:10]].mean(axis=0)
+    line = ca[small].mean(axis=0) - ca[~small].mean(axis=0)
+    axis = np.cross(line, [0.0, 0.0, 1.0] if abs(line[2]) < 0.9 * np.linalg.norm(line) else [1.0, 0.0, 0.0])
+    axis *= np.radians(angle) / np.linalg.norm(axis)
+    rotation = Rotation.from_rotvec(axis)
+    coords = structure.coords.copy()
+    segment = structure.segments[0]
+    for k in np.flatnonzero(small):
+        rows = segment.atoms(int(k))
+        coords[rows] = rotation.apply(coords[rows] - hinge) + hinge
+    return read_structure(write_structure(structure, coords, folder / "turned.pdb", overwrite=True)), int(small.sum())
+
+
+def large(folder: Path, file: str, angle: float, seed: int) -> Outcome:
+    """Fit chain A of ``file`` (from start ``seed``) into a 10 Å molmap map of itself with
+    its smaller domain turned ``angle`` degrees."""
+    with tempfile.TemporaryDirectory() as scratch:
+        start = chain_a(folder / file, Path(scratch))
+        end, size = turned(start, angle, Path(scratch))
+        start = started(start, seed, Path(scratch))
+    name = f"{file.split('.')[0]} ({len(start.segments[0])} residues), {size} turned {angle:g}°"
+    return map_fit(name, start, end, molmap(end, 10.0), 10.0)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--maps", action="store_true", help="also fit into simulated maps (several minutes)")
+    parser.add_argument("--large", type=Path, metavar="DIR",
+                        help="also fit large domain motions (LARGE_MOTIONS) made from entries of DIR")
     parser.add_argument("--others", type=Path, metavar="DIR", help="also fit other pairs (OTHER_PAIRS) from DIR")
     parser.add_argument("--starts", type=int, default=3, metavar="N",
                         help="perturbed starts of each fit for its spread (default 3; 0: two thread counts only)")
@@ -280,6 +408,10 @@ def main() -> None:
         print("\nInto simulated maps (anchor: iMODFIT, GroEL at 10 Å: 1.78 Å, CC 0.982, 244 s):")
         spreads += report([(maps, (*pair, resolution, made)) for made in ("molmap", "x-ray-like", "gemmi")
                            for resolution in (10.0, 6.0) for pair in ((OPEN, CLOSED), (CLOSED, OPEN))], plan, args.jobs)
+    if args.large:
+        print(f"\nLarge domain motions into 10 Å molmap maps (goal {GOAL_LARGE} Å; iMODFIT, GroEL at 10 Å: 1.78 Å, "
+              "CC 0.982, 244 s):")
+        spreads += report([(large, (args.large, file, angle)) for file, angle in LARGE_MOTIONS], plan, args.jobs)
     if args.others:
         print("\nOther proteins, into molmap maps of the target:")
         spreads += report([(other, (args.others, *pair, resolution)) for resolution in (10.0, 6.0)
