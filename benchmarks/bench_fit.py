@@ -19,6 +19,9 @@ residues paired by number, in both directions.
   transform cut sharply at the resolution, and noise), and into gemmi's electron density
   of the target (:func:`~core.fitting.simulated_maps.gemmi_like`). Anchor (published, not run here):
   iMODFIT fits GroEL (1AON into a 10 Å map of 1OEL) to 1.78 Å Cα rmsd, CC 0.982, in 244 s.
+* Every map fit is judged independently too (:func:`judges`): king-probe's clashscore and
+  mkdssp's helices and strands for the input, the target and the fitted model, beside the
+  project's own counts (``apt install king-probe dssp``; without them it says so).
 * Every figure is the fit of the files as read, on one BLAS thread; beside it its spread
   (``--starts N``, default 3): the same fit on two BLAS threads and from N starts whose
   coordinates are perturbed by up to ±0.001 Å, all run side by side in processes of
