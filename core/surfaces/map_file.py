@@ -7,8 +7,12 @@ voxel lies as ``mrcfile`` and ChimeraX place it.
 - **Modes** 0 (int8), 1 (int16), 2 (float32), 6 (uint16) and 12 (float16).
 - **Axis order** MAPC/MAPR/MAPS: the values come out indexed ``[x, y, z]``.
 - **Placement**: voxel ``i`` (along x, y, z) lies at ``ORIGIN + i · step`` where the MRC-2014
-  ORIGIN words are not all zero, else at ``(start + i) · step``, with the steps the cell's
-  axes over their samplings (MX, MY, MZ), as ChimeraX places them.
+  ORIGIN words are there ('MAP ' in word 53), not all zero and not so large that the grid's
+  steps vanish in them (RELION 2.0 left them unset), else at ``(start + i) · step`` (at
+  ``i · step`` where the start indices are unset: far beyond the grid), with the steps the
+  cell's axes over their samplings (MX, MY, MZ), as ChimeraX places them.
+- **Bytes** of mode 0 are signed, unsigned where IMOD's flags say so; a header that counts
+  symmetry records the file lacks (some EMDB entries) is read as ChimeraX reads it.
 - **Crystallographic maps**, a box smaller than its cell or a space group beyond P1, are
   periodic: they are expanded to the whole cell with the space group's symmetry (gemmi),
   and sampled around a model wherever it lies (:attr:`DensityMap.periodic`).
@@ -34,6 +38,8 @@ MODES = {0: np.int8, 1: np.int16, 2: np.float32, 6: np.uint16, 12: np.float16}
 MAX_VOXELS = 1024**3
 """The largest map read (4 GiB as float32): a bigger header is refused before any data is read."""
 HEADER_BYTES = 1024
+IMOD_STAMP = 1146047817
+"""Word 39 of a map IMOD wrote; bit 0 of word 40 set where its bytes (mode 0) are signed."""
 
 _RESOLUTION_LABEL = re.compile(r"resolution[^0-9]{0,12}(\d+(?:\.\d+)?)", re.IGNORECASE)
 
@@ -72,21 +78,25 @@ def _read(file: BinaryIO) -> DensityMap:
     sampling, cell = words[7:10].astype(np.float64), floats[10:16].astype(np.float64)
     axis_crs = _axis_order(words[16:19])
     spacegroup, extended = int(words[22]), int(words[23])
-    origin = floats[49:52].astype(np.float64)
+    origin = floats[49:52].astype(np.float64) if header[208:212] == b"MAP " else np.zeros(3)
 
     if mode in (3, 4):
         raise MapError(f"mode {mode} holds complex (Fourier) values, not a density map")
     if mode not in MODES:
         raise MapError(f"mode {mode} is not a mode of density values (0, 1, 2, 6 or 12)")
+    if np.any(size_crs <= 0):
+        raise MapError(f"its grid size {' × '.join(map(str, size_crs))} is not a size")
     if np.prod(size_crs, dtype=np.int64) > MAX_VOXELS:
         raise MapError(f"a grid of {' × '.join(map(str, size_crs))} voxels is larger than the {MAX_VOXELS:,} read")
     if extended < 0:
         raise MapError(f"the extended header's length ({extended} bytes) is negative")
-    dtype = np.dtype(MODES[mode]).newbyteorder(order)
+    unsigned = mode == 0 and words[38] == IMOD_STAMP and not words[39] & 1
+    dtype = np.dtype(np.uint8 if unsigned else MODES[mode]).newbyteorder(order)
     count = int(np.prod(size_crs))
-    if len(file.read(extended)) < extended:
-        raise MapError("the file ends inside its extended header")
+    records = file.read(extended)
     data = file.read(count * dtype.itemsize)
+    if len(data) < count * dtype.itemsize and len(records) + len(data) == count * dtype.itemsize:
+        data = records + data  # symmetry records counted in the header but not in the file
     if len(data) < count * dtype.itemsize:
         raise MapError(f"truncated: {len(data):,} bytes of values where its header asks for {count * dtype.itemsize:,}")
     sections = np.frombuffer(data, dtype=dtype).reshape(size_crs[::-1])  # [section, row, column]
@@ -103,12 +113,25 @@ def _read(file: BinaryIO) -> DensityMap:
 
     cell, sampling = _cell(cell, sampling, values.shape)
     axes = (np.array(gemmi.UnitCell(*cell).orth.mat.tolist()) / sampling).T  # rows: the steps along x, y, z
-    corner = origin if np.any(origin != 0) and np.all(np.isfinite(origin)) else start @ axes
+    corner = origin if _placed_by(origin, axes) else start @ axes if _placed_by_start(start, values.shape, sampling) \
+        else np.zeros(3)
     resolution = _resolution(header, words)
     if spacegroup > 1 or np.any(values.shape < sampling):
         whole = _unit_cell(values, start, sampling.astype(int), gemmi.UnitCell(*cell), spacegroup)
         return DensityMap(whole, corner - start @ axes, axes, periodic=True, resolution=resolution)
     return DensityMap(values, corner, axes, resolution=resolution)
+
+
+def _placed_by(origin: np.ndarray, axes: np.ndarray) -> bool:
+    """Whether the ORIGIN words place the map: not all zero, finite, and not so large that
+    a grid step vanishes in them."""
+    steps = np.linalg.norm(axes, axis=1)
+    return bool(np.any(origin != 0) and np.all(np.isfinite(origin)) and np.all(origin + steps != origin))
+
+
+def _placed_by_start(start: np.ndarray, shape: tuple[int, ...], sampling: np.ndarray) -> bool:
+    """Whether the start indices are set: within ten grids of 0 (as ChimeraX judges them)."""
+    return bool(np.all(np.abs(start) <= 10 * max(max(shape), sampling.max())))
 
 
 def _byte_order(header: bytes) -> str:

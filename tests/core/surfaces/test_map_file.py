@@ -186,4 +186,39 @@ def test_what_cannot_be_read_is_refused_saying_why(tmp_path: Path, placed) -> No
     refused("mode-9.mrc", patched(w3=9), "not a mode of density values")
     refused("axes.mrc", patched(w16=2), "not an order of 1, 2, 3")
     refused("huge.mrc", patched(w0=60000, w1=60000, w2=60000), "larger than")
-    refused("extended.mrc", patched(w23=10**9), "ends inside its extended header")
+    refused("extended.mrc", patched(w23=4000)[:-100], "truncated")
+    refused("empty-grid.mrc", patched(w1=0), "is not a size")
+
+
+def test_what_other_readers_forgive_is_forgiven(tmp_path: Path, placed) -> None:
+    """As ChimeraX reads them: ORIGIN words left unset (huge, as RELION 2.0 left them) or in
+    a file without the MRC-2014 'MAP ' word place nothing; start indices far beyond the grid
+    are unset; a header counting symmetry records the file lacks; IMOD's unsigned bytes."""
+    density, atoms = placed
+    expected = density.interpolate(atoms)
+    start = start_of(density)
+
+    def patched(path: Path, **words: float) -> Path:
+        raw = bytearray(path.read_bytes())
+        for word, value in words.items():
+            k = int(word.removeprefix("w"))
+            raw[4 * k : 4 * k + 4] = np.array(value, dtype="<f4" if isinstance(value, float) else "<i4").tobytes()
+        path.write_bytes(bytes(raw))
+        return path
+
+    unset = write_mrc(tmp_path / "unset.mrc", density.values, start=start, step=step(density))
+    patched(unset, w49=1e30, w50=1e30, w51=1e30)
+    assert np.allclose(read_map(unset).interpolate(atoms), expected, rtol=1e-5, atol=1e-6)
+    old_style = write_mrc(tmp_path / "old.mrc", density.values, start=start, origin=(500.0, 500.0, 500.0),
+                          step=step(density))
+    patched(old_style, w52=0)  # no 'MAP ': the words are not an origin
+    assert np.allclose(read_map(old_style).interpolate(atoms), expected, rtol=1e-5, atol=1e-6)
+    garbage = write_mrc(tmp_path / "garbage.mrc", density.values, start=(10**8, 0, 0), step=step(density))
+    assert np.allclose(read_map(garbage).origin, 0.0)
+    lacking = patched(write_mrc(tmp_path / "lacking.mrc", density.values, start=start, step=step(density)), w23=800)
+    assert np.allclose(read_map(lacking).interpolate(atoms), expected, rtol=1e-5, atol=1e-6)
+    scaled = np.round(density.values / density.values.max() * 250).astype(np.uint8)
+    imod = tmp_path / "imod.mrc"
+    write_mrc(imod, scaled.view(np.int8), start=start, step=step(density), dtype=np.int8)
+    patched(imod, w38=1146047817, w39=0)  # IMOD's stamp, its bytes unsigned
+    assert read_map(imod).values.max() == 250 and read_map(imod).values.min() >= 0
