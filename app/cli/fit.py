@@ -26,11 +26,10 @@ from core.geometry.validation import validate
 from core.protein.model import EditableModel
 from core.protein.structure import Structure, ca_rows
 from core.protein.writing import write_models
-from core.surfaces.map_file import read_map
+from core.surfaces.map_file import MAP_SUFFIXES, read_map
 from core.surfaces.volume import MapError
 
 DEFAULT_LEVELS = (0, 6)
-MAP_SUFFIXES = (".ccp4", ".mrc", ".map", ".mtz")
 MAX_FRAMES = 1000
 CHECKED = (("peptide_bond", "bad peptide bonds"), ("ca_ca", "bad Cα–Cα"), ("clash", "clashes"),
            ("ramachandran", "Ramachandran outliers"))

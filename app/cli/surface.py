@@ -23,20 +23,19 @@ from core.protein.reading import read_atoms
 from core.protein.structure import AtomTable, StructureError
 from core.surfaces.dna import ideal_bdna
 from core.surfaces.levelled import KINDS, UNITS, LevelledSurface, build_surface
-from core.surfaces.map_file import read_map
+from core.surfaces.map_file import MAP_SUFFIXES, read_map
 from core.surfaces.mesh import TriangleMesh
 from core.surfaces.molecular import COLOURINGS
 from core.surfaces.volume import MapError
 
 OUTPUTS = (".vtp", ".ply", ".png")
-MAP_SUFFIXES = (".ccp4", ".map", ".mrc")
 IDEAL_DNA_REPEAT = "CGCGAATTCGCG"
 """Sequence of the ideal B-DNA model, repeated (the Dickerson dodecamer of 1BNA)."""
 
 
 def surface_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("file", type=Path, nargs="?", metavar="FILE",
-                        help="structure (PDB or mmCIF, optionally gzipped), or a CCP4/MRC map for --kind map")
+                        help="structure (PDB or mmCIF, optionally gzipped), or a CCP4/MRC map or MTZ file for --kind map")
     model_argument(parser)
     parser.add_argument("--kind", choices=KINDS, default="ses",
                         help="ses: molecular surface (default); globe: sphere-topology spline surface; "

@@ -33,6 +33,8 @@ import numpy as np
 from core.surfaces.map_coefficients import is_mtz, read_mtz
 from core.surfaces.volume import DensityMap, MapError
 
+MAP_SUFFIXES = (".ccp4", ".map", ".mrc", ".mtz")
+"""The file names (less a ``.gz``) that the command line reads as maps, not structures."""
 MODES = {0: np.int8, 1: np.int16, 2: np.float32, 6: np.uint16, 12: np.float16}
 """The MRC modes of density values and their types (little-endian; swapped as the file says)."""
 MAX_VOXELS = 1024**3

@@ -13,6 +13,7 @@ import pyvista as pv
 from app.main import main
 from core.protein.reading import read_atoms
 from core.surfaces.volume import model_density
+from tests.conftest import write_mtz
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 
@@ -75,6 +76,16 @@ def test_map_from_a_ccp4_file(tmp_path: Path, capsys) -> None:
     assert status == 0 and pv.read(out).n_cells > 1000
     status, _, _ = run(capsys, str(DATA / "1UBQ.pdb.gz"), "--kind", "map", "--color", "bfactor", "-o", str(tmp_path / "m.vtp"))
     assert status == 0 and "bfactor" in pv.read(tmp_path / "m.vtp").point_data
+
+
+def test_map_from_an_mtz_file(tmp_path: Path, capsys) -> None:
+    """The 2mFo−DFc map of an MTZ, its unit cell contoured (the crystal's molecules in it)."""
+    out = tmp_path / "mtz.vtp"
+    status, _, _ = run(capsys, str(write_mtz(tmp_path / "refined.mtz")), "--kind", "map", "--contour", "1.5", "-o", str(out))
+    mesh = pv.read(out)
+    assert status == 0 and mesh.n_cells > 1000
+    cell = np.array(gemmi.read_mtz_file(str(tmp_path / "refined.mtz")).cell.parameters[:3])
+    assert np.all(mesh.points.min(axis=0) >= -1.0) and np.all(mesh.points.max(axis=0) <= cell + 1.0)
 
 
 @pytest.mark.parametrize(
