@@ -223,8 +223,8 @@ def judges(models: dict[str, tuple[Structure, np.ndarray]]) -> str:
     beside the project's own counts: king-probe's clashscore (MolProbity's serious overlaps,
     0.4 Å or more, per 1,000 atoms; heavy atoms only, no hydrogens added) and clashes per
     1,000 atoms of :func:`core.geometry.validation.validate`; helix and strand residues by
-    mkdssp and by :func:`core.protein.secondary_structure.dssp`, and the share of residues
-    whose state is the last model's."""
+    mkdssp and by :func:`core.protein.secondary_structure.dssp`, and the share of the
+    ``"fitted"`` model's residues whose state is the ``"target"``'s."""
     missing = [tool for tool in JUDGES if shutil.which(tool) is None]
     if missing:
         return f"  judges: {', '.join(missing)} not installed (apt install king-probe dssp)"
@@ -242,10 +242,9 @@ def judges(models: dict[str, tuple[Structure, np.ndarray]]) -> str:
             own_clashes = validate(structure, coords).counts["clash"] * 1000.0 / structure.n_atoms
             parts.append(f"{name} clashscore {1000.0 * len(pairs) / heavy:.1f} (own {own_clashes:.1f}), H/E "
                          f"{np.sum(theirs == 'H')}/{np.sum(theirs == 'E')} (own {np.sum(ours == 'H')}/{np.sum(ours == 'E')})")
-    last_theirs, last_ours = states[list(models)[-2]] if len(models) > 2 else states[list(models)[0]]
-    fitted_theirs, fitted_ours = states[list(models)[-1]]
-    same = (f"; secondary structure as the target's: mkdssp {np.mean(fitted_theirs == last_theirs):.0%}, own "
-            f"{np.mean(fitted_ours == last_ours):.0%}" if len(fitted_theirs) == len(last_theirs) else "")
+    (fitted_theirs, fitted_ours), (target_theirs, target_ours) = states["fitted"], states["target"]
+    same = (f"; secondary structure as the target's: mkdssp {np.mean(fitted_theirs == target_theirs):.0%}, own "
+            f"{np.mean(fitted_ours == target_ours):.0%}" if len(fitted_theirs) == len(target_theirs) else "")
     return "  judges: " + "; ".join(parts) + same
 
 

@@ -18,7 +18,7 @@ from core.analysis.compare import PAIRINGS
 from core.analysis.superpose import superpose
 from core.fitting.coarse_to_fine import Pairs
 from core.fitting.conformation import SAME_FOLD, fit_conformation, fold_similarity, pair_segments
-from core.fitting.density import RESOLUTION, MapTarget, fit_map, heavy_atoms
+from core.fitting.density import RESOLUTION, MapTarget, file_resolution, fit_map, heavy_atoms
 from core.fitting.map_quality import MapQuality, map_quality
 from core.fitting.morph import morph_frames
 from core.fitting.settle import FitResult
@@ -158,13 +158,11 @@ def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
         density = read_map(args.to)
     except MapError as error:
         raise InputError(str(error)) from None
-    resolution, source = (args.resolution, "--resolution") if args.resolution is not None else \
-        (density.resolution, "the file's")
-    if resolution is None:
+    given = (args.resolution, "--resolution") if args.resolution is not None else file_resolution(density)
+    if given is None:
         raise InputError(f"{args.to}: the file does not give its resolution; pass --resolution (Å), the resolution "
                          "to simulate the model's density at")
-    if not RESOLUTION[0] <= resolution <= RESOLUTION[1]:  # (only the file's can be out of range)
-        resolution, source = float(np.clip(resolution, *RESOLUTION)), f"the file's {resolution:g} Å, bounded"
+    resolution, source = given
     try:
         target = MapTarget(density, resolution, model.coords[heavy_atoms(model)])
     except (MapError, ValueError) as error:

@@ -137,7 +137,7 @@ def _write(mesh: TriangleMesh, scalars: np.ndarray | None, colouring: str | None
         raise
 
 
-def _render(polydata, scalars: np.ndarray | None, colouring: str | None, path: str) -> None:
+def _render(polydata, scalars: np.ndarray | None, colouring: str | None, path: str) -> None:  # noqa: ANN001
     import pyvista as pv
 
     plotter = pv.Plotter(off_screen=True, window_size=(900, 900))

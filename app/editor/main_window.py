@@ -421,10 +421,8 @@ class MainWindow(QMainWindow):
         kept = run_fit(document, fit_target, levels, self)
         if target == "map" and kept:
             self.correlation.judge()  # now, not after the edits' pause
-            quality = self.correlation.quality
-            if quality is not None:
-                labels = list(document.structure.segments[document.segment].labels)
-                self.statusBar().showMessage(f"Fitted to the map: {quality.summary(labels)}", 30000)
+            if self.correlation.quality is not None:
+                self.statusBar().showMessage(f"Fitted to the map: {self.correlation.summary()}", 30000)
         return kept
 
     def _compared(self) -> Compared:

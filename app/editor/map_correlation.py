@@ -4,7 +4,7 @@ The segment's heavy atoms, blurred to the map's resolution, are correlated with 
 a box around them (:class:`core.fitting.density.MapTarget`, built again when the segment,
 the map or the resolution changes). Edits (a drag's previews included) ask for a new value;
 it is computed between events, at most every :data:`INTERVAL_MS`. Once the edits pause for
-:data:`JUDGE_MS`, the segment is judged as a modeller judges a fit
+:data:`JUDGE_MS` (a drag's previews never: only when it ends), the segment is judged as a modeller judges a fit
 (:func:`core.fitting.map_quality.map_quality`: CC_mask, CC_box, each residue's CC, the
 residues outside the density).
 
@@ -101,15 +101,21 @@ class LiveCorrelation(QObject):
         self.quality = quality
         self.judged.emit()
 
-    def _map_opened(self) -> None:
-        from core.fitting.density import RESOLUTION
+    def summary(self) -> str:
+        """The judgement in a line for people (empty without one), residues by their labels."""
+        if self.quality is None:
+            return ""
+        document = self.document
+        return self.quality.summary(list(document.structure.segments[document.segment].labels))
 
-        given = self.maps.density.resolution
+    def _map_opened(self) -> None:
+        from core.fitting.density import file_resolution
+
+        given = file_resolution(self.maps.density)
         if given is None:
             self.resolution_source = "not given by the file: set it"
-            return
-        self.resolution = float(np.clip(given, *RESOLUTION))
-        self.resolution_source = "the file's" if self.resolution == given else f"the file's {given:.3g} Å, bounded"
+        else:
+            self.resolution, self.resolution_source = given
 
     def update(self) -> None:
         """Correlate now."""
@@ -157,4 +163,7 @@ class LiveCorrelation(QObject):
             return
         if not self._timer.isActive():
             self._timer.start(int(np.ceil(max(0.0, INTERVAL_MS - 1000.0 * (time.perf_counter() - self._last)))))
-        self._judge_timer.start(JUDGE_MS)
+        if self.document.dragging:  # (judged when the drag ends: 0.1-0.3 s, no pause of the mouse should cost it)
+            self._judge_timer.stop()
+        else:
+            self._judge_timer.start(JUDGE_MS)

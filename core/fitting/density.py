@@ -84,10 +84,20 @@ finer (:meth:`MapTarget.blurred`, :func:`level_resolution`); the refinement fits
 map as it is."""
 CRYSTAL_MASK = 3.0
 """Å beyond the atoms (and an atom's Gaussian width) that a crystal's map is kept around the
-model for a fit: beyond, its neighbours' density, flattened to the map's mean."""
+model for a fit: beyond, its neighbours' density, flattened to the solvent's level (the mean
+of the map at the mask's edge)."""
 RESOLUTION_PER_RESIDUE = 2.0
 """Å per residue of a span between a level's control points: the resolution that level
 sees the map at (:func:`level_resolution`; coarser levels see it coarser)."""
+
+
+def file_resolution(density: DensityMap) -> tuple[float, str] | None:
+    """The resolution a fit takes for ``density`` where its file gives one (bounded to
+    :data:`RESOLUTION`), and where it comes from, for people; None where the file gives none."""
+    if density.resolution is None:
+        return None
+    bounded = float(np.clip(density.resolution, *RESOLUTION))
+    return bounded, "the file's" if bounded == density.resolution else f"the file's {density.resolution:.3g} Å, bounded"
 
 
 def gaussian_sigma(resolution: float) -> float:
@@ -123,10 +133,9 @@ class MapTarget:
         self.shape = tuple(np.ceil((around.max(axis=0) + margin - self.origin) / self.spacing).astype(int) + 1)
         values = density.interpolate(self.points()).reshape(self.shape)
         if density.periodic:  # a crystal's map: the neighbours' density off, the model fitted into its own
-            radius = CRYSTAL_MASK + self.sigma
-            inside = self.near(around, radius)
-            edge = inside & ~self.near(around, radius - 1.0)  # the solvent's level, about
-            values = np.where(inside, values, values[edge].mean())
+            radius, distance = CRYSTAL_MASK + self.sigma, self.distances(around)
+            edge = (distance > radius - 1.0) & (distance <= radius)  # the solvent's level, about
+            values = np.where(distance <= radius, values, values[edge].mean())
         self._target = values - values.mean()
         self._target_norm = _norm(self._target)
         if self._target_norm == 0.0:
@@ -141,14 +150,14 @@ class MapTarget:
         """(n, 3) the grid's points, Å, in the order of its flattened values."""
         return self.origin + np.stack(np.indices(self.shape), axis=-1).reshape(-1, 3) * self.spacing
 
-    def near(self, coords: np.ndarray, radius: float) -> np.ndarray:
-        """Whether each grid point lies within ``radius`` Å of one of the atoms at ``coords``
-        (to half a grid step), on the grid."""
+    def distances(self, coords: np.ndarray) -> np.ndarray:
+        """Å from each grid point to the nearest of the atoms at ``coords`` (to half a grid
+        step), on the grid."""
         occupied = np.zeros(self.shape, dtype=bool)
         index = np.round((coords - self.origin) / self.spacing).astype(int)
         index = index[np.all((index >= 0) & (index < self.shape), axis=1)]
         occupied[tuple(index.T)] = True
-        return ndimage.distance_transform_edt(~occupied, sampling=self.spacing) <= radius
+        return ndimage.distance_transform_edt(~occupied, sampling=self.spacing)
 
     def blurred(self, resolution: float) -> MapTarget:
         """The map blurred to a coarser ``resolution`` (Å) and the model's density with it,

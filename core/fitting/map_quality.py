@@ -11,10 +11,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from core.fitting.density import MapTarget
+from core.surfaces.volume import DensityMap
 
 OUTSIDE_SIGMA = 1.0
 """A residue whose atoms sit, on average, below this many rms deviations above the map's
@@ -68,7 +68,8 @@ def map_quality(target: MapTarget, coords: np.ndarray, residue_of_atom: np.ndarr
     cc_mask = _cc(m - m.mean(), t - t.mean())
     per_residue = _grouped_cc(m, t, owner, residues)
     level = OUTSIDE_SIGMA * mapped.std()  # (the target is the map less its mean)
-    at_atoms = np.bincount(residue_of_atom, _interpolate(target, coords), residues)
+    on_grid = DensityMap(target.target, target.origin, target.spacing * np.eye(3))
+    at_atoms = np.bincount(residue_of_atom, on_grid.interpolate(coords), residues)
     counts = np.bincount(residue_of_atom, minlength=residues)
     with np.errstate(invalid="ignore", divide="ignore"):
         outside = np.flatnonzero((counts > 0) & (at_atoms / counts < level))
@@ -90,8 +91,3 @@ def _grouped_cc(a: np.ndarray, b: np.ndarray, group: np.ndarray, groups: int) ->
         spread = np.sqrt((saa - sa * sa / n) * (sbb - sb * sb / n))
         return np.where((n > 1) & (spread > 0), covariance / spread, np.nan)
 
-
-def _interpolate(target: MapTarget, coords: np.ndarray) -> np.ndarray:
-    """The target map (less its mean) at ``coords``, trilinearly."""
-    index = (coords - target.origin) / target.spacing
-    return ndimage.map_coordinates(target.target, index.T, order=1, mode="nearest")

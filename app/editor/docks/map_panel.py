@@ -195,12 +195,7 @@ class MapPanel(QWidget):
             self.cc_text.setText(correlation.message)
 
     def _show_quality(self) -> None:
-        quality, document = self.correlation.quality, self.correlation.document
-        if quality is None:
-            self.quality_text.setText("")
-            return
-        labels = list(document.structure.segments[document.segment].labels)
-        self.quality_text.setText(quality.summary(labels))
+        self.quality_text.setText(self.correlation.summary())
 
     def _refused(self, message: str) -> None:
         self.refused_text.setText(message)

@@ -22,9 +22,8 @@ from PySide6.QtCore import QObject, Qt, QTimer, Signal
 from app.editor.document import Document
 from app.polydata import to_polydata
 
-from core.surfaces.mesh import TriangleMesh
-
 if TYPE_CHECKING:
+    from core.surfaces.mesh import TriangleMesh
     from core.surfaces.volume import DensityMap
 
 DEFAULT_SIGMA = 1.0
@@ -157,16 +156,18 @@ class MapMesh(QObject):
         self.contoured.emit()
 
     def _contour(self, density: DensityMap, value: float) -> TriangleMesh:
-        """``density``'s contour at ``value``: around the view's centre, or the whole of it."""
+        """``density``'s contour at ``value``: around the view's centre, or the whole of it
+        (a crystal's map: the box around the model), as the sphere that holds it."""
         if not self.whole:
             return density.contour_around(value, self.centre, self.radius)
-        if not density.periodic:
-            if density.values.min() < value < density.values.max():
-                return density.contour(value)
-            return TriangleMesh(np.empty((0, 3)), np.empty((0, 3), dtype=np.int64))
-        coords = self.document.model.coords if self.document.editable else np.zeros((1, 3))
-        low, high = coords.min(axis=0), coords.max(axis=0)
-        return density.contour_around(value, (low + high) / 2.0, np.linalg.norm(high - low) / 2.0 + WHOLE_MARGIN)
+        if density.periodic:  # around the model
+            held = self.document.model.coords if self.document.editable else np.zeros((1, 3))
+            margin = WHOLE_MARGIN
+        else:  # the box's corners
+            corners = np.array(list(np.ndindex(2, 2, 2))) * (np.array(density.values.shape) - 1)
+            held, margin = density.origin + corners @ density.axes, 0.0
+        low, high = held.min(axis=0), held.max(axis=0)
+        return density.contour_around(value, (low + high) / 2.0, np.linalg.norm(high - low) / 2.0 + margin)
 
     def _redraw(self) -> None:
         self.contour()
@@ -177,7 +178,8 @@ class MapMesh(QObject):
 
     def _frame(self) -> None:
         """A frame is drawn: contour again soon where the centre moved."""
-        if self.density is None or self._timer.isActive() or np.array_equal(self._focal_point(), self.centre):
+        if (self.density is None or self.whole or self._timer.isActive()
+                or np.array_equal(self._focal_point(), self.centre)):
             return
         wait = RECONTOUR_MS - 1000.0 * (time.perf_counter() - self._last)
         self._timer.start(int(np.ceil(max(0.0, wait))) + 2)  # Qt's timers may fire a millisecond or two early

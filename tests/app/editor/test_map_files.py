@@ -12,9 +12,11 @@ from PySide6.QtWidgets import QInputDialog
 from pytestqt.qtbot import QtBot
 
 from app.editor.main_window import MainWindow
-from app.editor.scene.map_mesh import DIFFERENCE_ACTORS, DIFFERENCE_COLOURS
+from app.editor.scene.map_mesh import DIFFERENCE_ACTORS, DIFFERENCE_COLOURS, RECONTOUR_MS
 from core.fitting.density import RESOLUTION
-from tests.conftest import D_MIN, MISSING, write_mtz
+from core.protein.reading import read_atoms
+from core.surfaces.volume import model_density
+from tests.conftest import DATA, D_MIN, MISSING, write_mrc, write_mtz
 
 
 @pytest.fixture
@@ -94,3 +96,23 @@ def test_columns_refinement_does_not_name_are_chosen(open_window: Callable[[str]
     assert asked == [["FCALC, PHCALC", "FDIFF, PHDIFF"]]
     assert window.maps.columns == (("FCALC", "PHCALC"), None)
     assert len(MISSING) == 6
+
+
+def test_the_whole_of_a_box_is_contoured_once(open_window: Callable[[str], MainWindow], tmp_path: Path,
+                                              qtbot: QtBot) -> None:
+    """A box map drawn whole is the contour of all of it, not contoured again as the view pans."""
+    window = open_window("1UBQ.pdb.gz")
+    density = model_density(read_atoms(DATA / "1UBQ.pdb.gz"), spacing=1.0, resolution=4.0, margin=8.0)
+    window.rw.open_map(write_mrc(tmp_path / "box.mrc", density.values, origin=tuple(density.origin),
+                                 step=np.diag(density.axes)))
+    maps = window.maps
+    window.map_panel.whole.setChecked(True)
+    whole = density.contour(maps.value)
+    assert maps.mesh.n_cells == pytest.approx(whole.n_faces, rel=0.02)
+    contoured = []
+    maps.contoured.connect(lambda: contoured.append(1))
+    frames = window.plotter.frames
+    window.go_to("40")  # the view's centre moves
+    qtbot.waitUntil(lambda: window.plotter.frames > frames)
+    qtbot.wait(3 * RECONTOUR_MS)
+    assert not contoured

@@ -20,7 +20,7 @@ from pytestqt.qtbot import QtBot
 from scipy import ndimage
 
 from app.editor.main_window import MainWindow
-from app.editor.map_correlation import INTERVAL_MS
+from app.editor.map_correlation import INTERVAL_MS, JUDGE_MS
 from app.editor.scene.map_mesh import RECONTOUR_MS
 from core.analysis.superpose import superpose
 from core.fitting.density import gaussian_sigma
@@ -149,6 +149,19 @@ def test_the_correlation_shows_and_follows_edits_ten_times_a_second(window: Main
     qtbot.wait(2 * INTERVAL_MS)
     assert correlation.updates == before + 1 and correlation.value != first
     document.cancel_drag()
+
+
+def test_a_drag_is_judged_when_it_ends_not_while_the_mouse_rests(window: MainWindow, qtbot: QtBot) -> None:
+    correlation, document = window.correlation, window.document
+    qtbot.waitUntil(lambda: correlation.quality is not None, timeout=5000)
+    judged = []
+    correlation.judged.connect(lambda: judged.append(correlation.quality))
+    document.pick_point(5)
+    document.preview_move(5, np.array([3.0, 0.0, 0.0]))
+    qtbot.wait(3 * JUDGE_MS)  # the mouse held still in the middle of the drag
+    assert not judged
+    document.finish_drag("Move control point")
+    qtbot.waitUntil(lambda: len(judged) == 1, timeout=5000)
 
 
 def test_fit_to_map_at_this_level_is_one_undo_step(window: MainWindow) -> None:
