@@ -17,8 +17,20 @@ from app.errors import InputError
 from core.analysis.compare import PAIRINGS
 from core.analysis.superpose import superpose
 from core.fitting.coarse_to_fine import Pairs
-from core.fitting.conformation import SAME_FOLD, fit_conformation, fold_similarity, pair_segments
-from core.fitting.density import RESOLUTION, MapTarget, file_resolution, fit_map, heavy_atoms
+from core.fitting.conformation import (
+    SAME_FOLD,
+    fit_conformation,
+    fold_similarity,
+    pair_segments,
+)
+from core.fitting.density import (
+    RESOLUTION,
+    MapTarget,
+    file_resolution,
+    fit_map,
+    heavy_atoms,
+)
+from core.fitting.domains import DOMAINS
 from core.fitting.map_quality import MapQuality, map_quality
 from core.fitting.morph import morph_frames
 from core.fitting.settle import FitResult
@@ -65,6 +77,9 @@ def fit_arguments(parser: argparse.ArgumentParser) -> None:
                         help="for a map target: its resolution, which the model's density is simulated at "
                              f"({RESOLUTION[0]:g} to {RESOLUTION[1]:g} Å; default: the file's, where it gives one: "
                              "an MTZ's high-resolution limit, a map's header label)")
+    parser.add_argument("--no-domains", dest="domains", action="store_false",
+                        help="for a map target: leave out the first stage, the chain's smaller dynamic domain moved "
+                             "as a rigid body before the levels (it runs when the levels start at 0)")
     parser.add_argument("--no-regularize", dest="regularize", action="store_false",
                         help="leave the residues as the fit remaps them (peptide junctions may stretch)")
     parser.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
@@ -91,11 +106,13 @@ def run_fit(args: argparse.Namespace) -> int:
     except (ValueError, OSError) as error:
         raise InputError(str(error)) from None
     what = report.pop("what")
-    levels = [{"level": f.level, "control_points": f.control_points, measure: round(f.score, 4),
-               "seconds": round(f.seconds, 4)} for f in result.levels]
+    levels = [{"level": f.level if f.level != DOMAINS else "domains", "control_points": f.control_points,
+               measure: round(f.score, 4), "seconds": round(f.seconds, 4)} for f in result.levels]
     for level, f in zip(levels, result.levels):
         if f.resolution is not None:  # a map, as that level saw it
             level["resolution"] = round(f.resolution, 2)
+        if f.level == DOMAINS:
+            level["moved"] = f.motion
     report.update({
         "model": str(args.file), "target": str(args.to), "levels": levels,
         "dropped_levels": result.dropped, "regularized": args.regularize, "refined": bool(result.refinement),
@@ -109,6 +126,10 @@ def run_fit(args: argparse.Namespace) -> int:
     print(f"{what}; {name} after each level:")
     for f, level in zip(result.levels, levels):
         seen = f" at {level['resolution']:4.1f} Å" if "resolution" in level else ""
+        if f.level == DOMAINS:
+            print(f"  domains: {f.motion or 'none moved (no gain in correlation)'}; {name} {f.score:6.3f}{unit}{seen}, "
+                  f"{f.seconds:6.2f} s")
+            continue
         print(f"  level {f.level}: {f.control_points:4d} control points, {name} {f.score:6.3f}{unit}{seen}, "
               f"{f.seconds:6.2f} s")
     if result.dropped:
@@ -136,12 +157,12 @@ for a map how well the model fits it now."""
 
 
 def _fit_structure(model: EditableModel, args: argparse.Namespace) -> Fitted:
-    if args.resolution is not None:
-        raise InputError("--resolution is for a map target; TARGET is a structure")
+    if args.resolution is not None or not args.domains:
+        raise InputError("--resolution and --no-domains are for a map target; TARGET is a structure")
     target = load(args.to)
     pairs, pairing, rows = _paired(model, args.chain, target, args.target_chain, args.pairing)
     result = _settled(lambda levels: fit_conformation(model, pairs, levels, regularize=args.regularize), args.levels)
-    report = {"pairing": pairing, "pairs": int(len(rows)), "what": f"{len(rows)} residue pairs ({pairing})"}
+    report = {"pairing": pairing, "pairs": len(rows), "what": f"{len(rows)} residue pairs ({pairing})"}
     return result, report, "rmsd", lambda: superpose(model.coords[rows], np.concatenate([p.target for p in pairs])).rmsd, \
         None
 
@@ -167,7 +188,8 @@ def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
         target = MapTarget(density, resolution, model.coords[heavy_atoms(model)])
     except (MapError, ValueError) as error:
         raise InputError(str(error)) from None
-    result = _settled(lambda levels: fit_map(model, segments, target, levels, regularize=args.regularize),
+    first = [DOMAINS] if args.domains and args.levels[0] == 0 else []
+    result = _settled(lambda levels: fit_map(model, segments, target, [*first, *levels], regularize=args.regularize),
                       args.levels)
     rows = heavy_atoms(model)
     report = {"resolution": round(resolution, 2), "resolution_from": source, "segments": len(segments),

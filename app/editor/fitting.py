@@ -30,6 +30,7 @@ from app.editor.scene.overlay import Compared, chain_segments
 from core.fitting.coarse_to_fine import LevelFit, fit_levels
 from core.fitting.conformation import SAME_FOLD, fold_similarity, pair_segments
 from core.fitting.density import MapTarget, fit_map_levels, heavy_atoms, refine
+from core.fitting.domains import DOMAINS
 from core.fitting.settle import settle
 from core.protein.model import Edit
 from core.surfaces.volume import DensityMap
@@ -51,6 +52,9 @@ class FitTarget:
     """A level's score for people: ``'CC 0.953 at 13 Å'`` (the map as that level sees it), ``'Cα rmsd 1.21 Å'``."""
     refine: Refines | None = None
     """For a map: every residue moved into it on its own, its side chains turning."""
+    domains: bool = False
+    """For a map: coarse to fine, the chain's smaller dynamic domain is first moved as a rigid
+    body (:mod:`core.fitting.domains`), a stage of its own."""
 
 
 def edited_chain(document: Document) -> list[int]:
@@ -68,7 +72,7 @@ def map_target(document: Document, density: DensityMap, resolution: float) -> Fi
     return FitTarget("map", lambda levels, cancelled: fit_map_levels(model, segments, target, levels,
                                                                        cancelled=cancelled),
                      lambda fit: f"CC {fit.score:.3f} at {fit.resolution:.3g} Å",
-                     lambda cancelled: refine(model, segments, target, cancelled=cancelled))
+                     lambda cancelled: refine(model, segments, target, cancelled=cancelled), domains=True)
 
 
 def compared_target(document: Document, compared: Compared) -> FitTarget:
@@ -88,10 +92,18 @@ def compared_target(document: Document, compared: Compared) -> FitTarget:
                      lambda fit: f"Cα rmsd {fit.score:.2f} Å")
 
 
-def levels_to_fit(document: Document, coarse_to_fine: bool) -> list[int]:
-    """The integer level at or below the one shown, or every level from 0 up to it."""
+def levels_to_fit(document: Document, target: FitTarget, coarse_to_fine: bool) -> list[int]:
+    """The integer level at or below the one shown, or every level from 0 up to it (after
+    the domains, :data:`~core.fitting.domains.DOMAINS`, where ``target`` moves them first)."""
     level = math.floor(document.shown_level())
-    return list(range(level + 1)) if coarse_to_fine else [level]
+    if not coarse_to_fine:
+        return [level]
+    return [DOMAINS] * target.domains + list(range(level + 1))
+
+
+def _stage(level: int) -> str:
+    """A stage of a fit for people: ``'level 3'``, ``'the domains'``."""
+    return "the domains" if level == DOMAINS else f"level {level}"
 
 
 def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent: QWidget) -> list[LevelFit]:
@@ -101,7 +113,7 @@ def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent
     levels kept."""
     settles = len(levels) > 1
     stages = len(levels) + (1 + (target.refine is not None) if settles else 0)
-    progress = QProgressDialog(f"Fitting to the {target.name} at level {levels[0]}…", "Cancel", 0, stages, parent)
+    progress = QProgressDialog(f"Fitting {_stage(levels[0])} to the {target.name}…", "Cancel", 0, stages, parent)
     progress.setWindowTitle(f"Fit to {target.name}")
     progress.setWindowModality(Qt.WindowModality.WindowModal)
     progress.setMinimumDuration(0)
@@ -124,13 +136,14 @@ def run_fit(document: Document, target: FitTarget, levels: Sequence[int], parent
                     document.model.revert(edit)
                 break
             if fit.edits:
-                document.push_applied(fit.edits, f"Fit to {target.name} at level {fit.level} "
-                                                 f"({target.score(fit)})")
+                moved = f"; {fit.motion}" if fit.motion else ""
+                where = ": the domains" if fit.level == DOMAINS else f" at level {fit.level}"
+                document.push_applied(fit.edits, f"Fit to {target.name}{where} ({target.score(fit)}{moved})")
             kept.append(fit)
             progress.setValue(len(kept))
             if len(kept) < len(levels):
-                progress.setLabelText(f"Level {fit.level}: {target.score(fit)}. Fitting at level "
-                                      f"{levels[len(kept)]}…")
+                progress.setLabelText(f"{_stage(fit.level).capitalize()}: {target.score(fit)}. Fitting "
+                                      f"{_stage(levels[len(kept)])}…")
         if progress.wasCanceled():  # the levels kept are not regularized: the fit is undone
             document.undo_stack.setIndex(before)
             return []

@@ -417,7 +417,7 @@ class MainWindow(QMainWindow):
             QMessageBox.critical(self, APP_NAME, str(error))
             return []
         if levels is None:
-            levels = levels_to_fit(document, coarse_to_fine)
+            levels = levels_to_fit(document, fit_target, coarse_to_fine)
         kept = run_fit(document, fit_target, levels, self)
         if target == "map" and kept:
             self.correlation.judge()  # now, not after the edits' pause

@@ -127,7 +127,9 @@ class EditorAPI:
         the one shown; each level one undo step, and a fit of more than one level settled as
         on the command line (regularized, the finest levels that leave bad junctions undone)
         and refined (each residue and its side chains), a step each. ``resolution`` (Å) sets the map's resolution
-        first. Returns each level kept and the correlation after it."""
+        first. Returns each level kept and the correlation after it; coarse to fine (None) the
+        first is -1, the chain's smaller dynamic domain moved as a rigid body before level 0
+        (:mod:`core.fitting.domains`)."""
         if resolution is not None:
             self._window.correlation.set_resolution(float(resolution))
         return self._fit("map", levels)

@@ -69,6 +69,8 @@ class LevelFit:
     edits : one edit per fitted segment (already applied to the model), from the state
         before this level to the state after it.
     resolution : for a map, the resolution the level saw it at (Å); None for a structure.
+    motion : for the rigid-domain stage before the levels (``level`` -1,
+        :data:`core.fitting.domains.DOMAINS`), what moved, for people; None where nothing did.
     """
 
     level: int
@@ -77,6 +79,12 @@ class LevelFit:
     seconds: float
     edits: tuple[Edit, ...]
     resolution: float | None = None
+    motion: str | None = None
+
+    @property
+    def name(self) -> str:
+        """``'level 3'``, or ``'domains'`` for the rigid-domain stage (level -1)."""
+        return "domains" if self.level < 0 else f"level {self.level}"
 
 
 @lru_cache(maxsize=64)

@@ -65,7 +65,8 @@ def settle(model: EditableModel, fits: list[LevelFit], *, regularize: bool = Tru
     :data:`SCHEDULES` in turn); while the regularized model has clearly more bad peptide
     junctions and Ramachandran outliers than the input (:data:`BACKBONE`, by more than
     :data:`MARGIN` of the fitted residues), undo the finest level kept (with ``undo``,
-    where its edits are undo steps; else by reverting them) and try again."""
+    where its edits are undo steps; else by reverting them) and try again, while more than
+    one level moved something."""
     fits = list(fits)
     if not regularize:
         return FitResult(fits, [], [])
@@ -76,7 +77,7 @@ def settle(model: EditableModel, fits: list[LevelFit], *, regularize: bool = Tru
     while True:
         for schedule in SCHEDULES:
             edits = regularize_fit(model, fits, schedule)
-            if len(fits) <= 1 or _backbone_flags(model.structure, model.coords) <= allowed or cancelled():
+            if sum(1 for fit in fits if fit.edits) <= 1 or _backbone_flags(model.structure, model.coords) <= allowed or cancelled():
                 return FitResult(fits, edits, dropped)
             for edit in reversed(edits):
                 model.revert(edit)

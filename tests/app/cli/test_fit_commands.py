@@ -100,8 +100,10 @@ def test_fit_into_a_map_raises_the_correlation_and_nears_the_target(capsys, tmp_
                           "-o", out, "--json")
     report = json.loads(text)
     assert status == 0 and report["resolution"] == 10.0 and report["refined"]
-    assert [level["resolution"] for level in report["levels"]] == [30.0, 30.0, 30.0, 30.0, 26.75, 13.38]
-    cc = [level["cc"] for level in report["levels"]]
+    domains, *levels = report["levels"]
+    assert domains["level"] == "domains" and domains["resolution"] == 20.0 and "residues turned" in domains["moved"]
+    assert [level["resolution"] for level in levels] == [30.0, 30.0, 30.0, 30.0, 26.75, 13.38]
+    cc = [level["cc"] for level in levels]
     assert cc[-1] > cc[0] and cc[-1] > 0.96 and report["final"] > 0.96
     fitted = read_structure(out)
     ca, target = fitted.coords[ca_rows(fitted)], read_structure(OPEN).segments[0].ca
@@ -109,6 +111,19 @@ def test_fit_into_a_map_raises_the_correlation_and_nears_the_target(capsys, tmp_
     assert np.sqrt(np.mean(np.sum((ca - target) ** 2, axis=1))) < 0.5 * np.sqrt(np.mean(np.sum((start - target) ** 2,
                                                                                                 axis=1)))
     assert report["validation"]["peptide_bond"]["after"] == 0
+
+
+def test_the_domains_stage_is_said_and_can_be_left_out(capsys, tmp_path: Path) -> None:
+    density = _simulated_map(OPEN, 10.0, tmp_path / "open.ccp4")
+    out = tmp_path / "fitted.pdb"
+    status, text, _ = run(capsys, "fit", CLOSED, "--to", density, "--resolution", "10", "--levels", "0-1",
+                          "--no-regularize", "-o", out)
+    assert status == 0 and "  domains: 57 residues turned" in text.splitlines()[1]
+    status, text, _ = run(capsys, "fit", CLOSED, "--to", density, "--resolution", "10", "--levels", "0-1",
+                          "--no-regularize", "--no-domains", "-o", out, "--overwrite")
+    assert status == 0 and "domains:" not in text and text.splitlines()[1].startswith("  level 0:")
+    status, _, err = run(capsys, "fit", CLOSED, "--to", OPEN, "--no-domains", "-o", out, "--overwrite")
+    assert status == 1 and "--no-domains" in err
 
 
 def test_bad_maps_and_resolutions_are_refused(capsys, tmp_path: Path) -> None:

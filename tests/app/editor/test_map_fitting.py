@@ -24,6 +24,7 @@ from app.editor.map_correlation import INTERVAL_MS, JUDGE_MS
 from app.editor.scene.map_mesh import RECONTOUR_MS
 from core.analysis.superpose import superpose
 from core.fitting.density import gaussian_sigma
+from core.fitting.domains import DOMAINS
 from core.geometry.validation import validate
 from core.protein.reading import read_structure
 from core.protein.structure import ca_rows
@@ -185,11 +186,13 @@ def test_fit_to_map_coarse_to_fine_is_one_step_a_level_and_a_regularization(wind
     rmsd, cc = _ca_rmsd(window, target_ca), window.rw.map_correlation
     fitted = window.rw.fit_to_map(resolution=8.5)
     assert window.map_panel.resolution.value() == 8.5
-    assert [level for level, _ in fitted] == [0, 1, 2, 3]
+    assert [level for level, _ in fitted] == [DOMAINS, 0, 1, 2, 3]
     steps, index = window.rw.history()
-    assert index == 6 and [s.split(" (")[0] for s in steps[:4]] == [f"Fit to map at level {k}" for k in range(4)]
-    assert steps[4] == "Regularize the fit to map"
-    assert steps[5] == "Refine the fit to map (each residue, side chains)"
+    assert index == 7 and steps[0].startswith("Fit to map: the domains (CC ")  # the LID or NMP domain turned
+    assert "residues turned" in steps[0]
+    assert [s.split(" (")[0] for s in steps[1:5]] == [f"Fit to map at level {k}" for k in range(4)]
+    assert steps[5] == "Regularize the fit to map"
+    assert steps[6] == "Refine the fit to map (each residue, side chains)"
     assert window.rw.map_correlation > cc + 0.1
     assert _ca_rmsd(window, target_ca) < rmsd - 2.0  # towards the open form whose map it is
     window.rw.undo()  # the refinement: the residues and side chains back, as regularized
@@ -197,7 +200,7 @@ def test_fit_to_map_coarse_to_fine_is_one_step_a_level_and_a_regularization(wind
     window.rw.redo()
     side_chain = ~np.isin(document.structure.atoms.name, ("N", "CA", "C", "O", "CB"))
     assert np.abs(document.model.coords - regularized)[side_chain].max() > 1.0  # side chains turned
-    for _ in range(6):
+    for _ in range(7):
         window.rw.undo()
     assert np.array_equal(document.model.coords, document.structure.coords)
 

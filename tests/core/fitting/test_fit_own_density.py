@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from core.fitting.density import MapTarget, fit_map, heavy_atoms
+from core.fitting.domains import DOMAINS
 from core.fitting.simulated_maps import gemmi_like, molmap, xray_like
 from core.geometry.validation import validate
 from core.protein.model import EditableModel
@@ -24,7 +25,8 @@ from core.surfaces.volume import DensityMap
 from tests.conftest import write_mrc
 
 DATA = Path(__file__).resolve().parents[2] / "data"
-LEVELS = range(0, 7)
+LEVELS = (DOMAINS, *range(7))
+"""As ``ribbonwave fit`` fits: the domains first (none may move), then levels 0-6."""
 MAKERS = {"molmap": molmap, "x-ray-like": xray_like, "gemmi": gemmi_like}
 BOXES = {"tight": 3.0, "loose": 15.0}
 """Å of box around the atoms."""
