@@ -64,7 +64,7 @@ from scipy.spatial.transform import Rotation
 
 from core.analysis.superpose import superpose
 from core.fitting.conformation import fit_conformation, pair_segments
-from core.fitting.density import MapTarget, fit_map, heavy_atoms
+from core.fitting.density import MapTarget, fit_map, heavy_atoms, occupancies
 from core.fitting.domains import DOMAINS
 from core.fitting.simulated_maps import gemmi_like, molmap, xray_like
 from core.geometry.validation import validate
@@ -310,15 +310,16 @@ def map_fit(label: str, start: Structure, end: Structure, density: DensityMap, r
     rows, target_ca = ca_rows(start)[start.segments[0].residue_index[pairs[0].residues]], pairs[0].target
     target = MapTarget(density, resolution, model.coords[heavy_atoms(model)])
     heavy = heavy_atoms(model)
+    weights = occupancies(model, heavy)
 
     def rmsd() -> float:
         return float(np.sqrt(np.mean(np.sum((model.coords[rows] - target_ca) ** 2, axis=1))))
 
-    first = target.correlation(model.coords[heavy]), rmsd()
+    first = target.correlation(model.coords[heavy], weights), rmsd()
     began = time.perf_counter()
     result = fit_map(model, [0], target, MAP_LEVELS)
     seconds = time.perf_counter() - began
-    cc, final = target.correlation(model.coords[heavy]), rmsd()
+    cc, final = target.correlation(model.coords[heavy], weights), rmsd()
     dropped = f", level {', '.join(map(str, result.dropped))} undone" if result.dropped else ""
     levels = ", ".join(f"{f.name.removeprefix('level ')}: {f.score:.3f}" for f in result.levels)
     motion = next((f"; {f.motion}" for f in result.levels if f.motion), "")

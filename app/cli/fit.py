@@ -29,6 +29,7 @@ from core.fitting.density import (
     file_resolution,
     fit_map,
     heavy_atoms,
+    occupancies,
 )
 from core.fitting.domains import DOMAINS
 from core.fitting.map_quality import MapQuality, map_quality
@@ -196,8 +197,9 @@ def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
               "what": f"{len(segments)} segment(s) into the map at {resolution:.3g} Å ({source}; each level into the "
                       "map blurred as that level sees it)"}
     judged = rows[structure.atom_residue[rows] >= 0]  # the atoms of the chains' residues
-    return result, report, "cc", lambda: target.correlation(model.coords[rows]), \
-        lambda: map_quality(target, model.coords[judged], structure.atom_residue[judged], structure.n_residues)
+    return result, report, "cc", lambda: target.correlation(model.coords[rows], occupancies(model, rows)), \
+        lambda: map_quality(target, model.coords[judged], structure.atom_residue[judged], structure.n_residues,
+                            occupancies(model, judged))
 
 
 def _settled(fit: Callable[[range], FitResult], bounds: tuple[int, int]) -> FitResult:

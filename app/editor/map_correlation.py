@@ -61,6 +61,7 @@ class LiveCorrelation(QObject):
         """Correlations computed so far."""
         self._target: tuple[tuple, MapTarget | ValueError | None] = ((), None)  # by (structure, segment, map, resolution)
         self._rows = np.empty(0, dtype=np.int64)
+        self._occupancy = np.empty(0)
         self._last = -np.inf
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
@@ -97,7 +98,8 @@ class LiveCorrelation(QObject):
             if target is not None:
                 segment = document.structure.segments[document.segment]
                 residue = document.structure.atom_residue[self._rows] - int(segment.residue_index[0])
-                quality = map_quality(target, document.model.coords[self._rows], residue, len(segment))
+                quality = map_quality(target, document.model.coords[self._rows], residue, len(segment),
+                                      self._occupancy)
         self.quality = quality
         self.judged.emit()
 
@@ -126,7 +128,7 @@ class LiveCorrelation(QObject):
         if self.maps.density is not None and document.editable:
             try:
                 target = self._segment_target()
-                value = target.correlation(document.model.coords[self._rows])
+                value = target.correlation(document.model.coords[self._rows], self._occupancy)
             except ValueError as error:  # a MapError: the map does not overlap the segment
                 self.message = str(error)
         self.value = value
@@ -135,7 +137,11 @@ class LiveCorrelation(QObject):
 
     def _segment_target(self) -> MapTarget:
         """The map around the edited segment (raises MapError where the two do not overlap)."""
-        from core.fitting.density import MapTarget, heavy_atoms  # the fitting code loads with the first map
+        from core.fitting.density import (  # (loads with the first map)
+            MapTarget,
+            heavy_atoms,
+            occupancies,
+        )
 
         document = self.document
         key = (document.structure, document.segment, self.maps.density, self.resolution)
@@ -146,6 +152,7 @@ class LiveCorrelation(QObject):
                 mine[start:stop] = True
             rows = heavy_atoms(document.model)
             self._rows = rows[mine[rows]]
+            self._occupancy = occupancies(document.model, self._rows)
             try:
                 self._target = (key, MapTarget(self.maps.density, self.resolution, document.model.coords[self._rows]))
             except ValueError as error:  # a MapError

@@ -180,27 +180,31 @@ class MapTarget:
                                                   resolution, self._around, self._margin)
         return self._blurred[resolution]
 
-    def density(self, coords: np.ndarray) -> np.ndarray:
-        """The model's density on the grid for atoms at ``coords`` (n, 3)."""
+    def density(self, coords: np.ndarray, occupancy: np.ndarray | None = None) -> np.ndarray:
+        """The model's density on the grid for atoms at ``coords`` (n, 3), each weighted by
+        its ``occupancy`` (n,; default 1), as a map shows a partly occupied atom."""
         flat, keep, weight, _ = self._corners(coords)
+        if occupancy is not None:
+            weight = weight * occupancy
         spread = np.bincount(flat[keep], weight[keep], int(np.prod(self.shape)))
         return self._blur(spread.reshape(self.shape).astype(np.float64))  # integers when no atom is on the grid
 
-    def correlation(self, coords: np.ndarray) -> float:
-        """CC about the mean of the model's density with the map."""
-        model = self.density(coords)
+    def correlation(self, coords: np.ndarray, occupancy: np.ndarray | None = None) -> float:
+        """CC about the mean of the model's density (:meth:`density`) with the map."""
+        model = self.density(coords, occupancy)
         model -= model.mean()
         norm = _norm(model)
         return float(np.sum(model * self._target) / (norm * self._target_norm)) if norm > 0 else 0.0
 
-    def gradient(self, coords: np.ndarray) -> tuple[float, np.ndarray]:
-        """The CC and its gradient (n, 3) with respect to each atom's position (1/Å).
+    def gradient(self, coords: np.ndarray, occupancy: np.ndarray | None = None) -> tuple[float, np.ndarray]:
+        """The CC (as :meth:`correlation`) and its gradient (n, 3) with respect to each atom's
+        position (1/Å).
 
         The density spreads each atom trilinearly and blurs; both are adjoint to what the
         gradient does (the blur is symmetric, trilinear spreading the transpose of trilinear
         interpolation), so the exact gradient is that of the trilinear interpolant of the
         blurred ∂CC/∂density at each atom."""
-        model = self.density(coords)
+        model = self.density(coords, occupancy)
         model -= model.mean()
         norm = _norm(model)
         if norm == 0.0:
@@ -208,7 +212,8 @@ class MapTarget:
         cc = float(np.sum(model * self._target) / (norm * self._target_norm))
         field = self._blur(self._target / (norm * self._target_norm) - cc * model / norm**2).ravel()
         flat, keep, _, slopes = self._corners(coords)
-        return cc, np.einsum("cn,cni->ni", np.where(keep, field[flat], 0.0), slopes) / self.spacing
+        gradient = np.einsum("cn,cni->ni", np.where(keep, field[flat], 0.0), slopes) / self.spacing
+        return cc, gradient if occupancy is None else gradient * occupancy[:, None]
 
     def _blur(self, grid: np.ndarray) -> np.ndarray:
         return ndimage.gaussian_filter(grid, self.sigma / self.spacing, mode="constant", truncate=3.0)
@@ -245,13 +250,21 @@ def heavy_atoms(model: EditableModel) -> np.ndarray:
     return np.flatnonzero(~np.isin(np.char.upper(atoms.element.astype(str)), ("H", "D")) & (atoms.category != "water"))
 
 
+def occupancies(model: EditableModel, rows: np.ndarray) -> np.ndarray:
+    """The occupancy of the atoms at ``rows`` of ``model``, in [0, 1]: how much of each a map
+    shows (a side chain in two conformations, half each; a tail half ordered)."""
+    return np.clip(np.nan_to_num(model.structure.atoms.occupancy[rows], nan=1.0), 0.0, 1.0)
+
+
 def atom_correlation(model: EditableModel, target: MapTarget) -> Callable[[np.ndarray], tuple[float, np.ndarray]]:
-    """The CC of ``model``'s heavy atoms with ``target`` as a function of all its
-    coordinates: the CC and its gradient (n_atoms, 3), zero for the other atoms."""
+    """The CC of ``model``'s heavy atoms (each by its :func:`occupancies`) with ``target`` as a
+    function of all its coordinates: the CC and its gradient (n_atoms, 3), zero for the other
+    atoms."""
     rows = heavy_atoms(model)
+    weights = occupancies(model, rows)
 
     def correlation(coords: np.ndarray) -> tuple[float, np.ndarray]:
-        cc, gradient = target.gradient(coords[rows])
+        cc, gradient = target.gradient(coords[rows], weights)
         total = np.zeros_like(coords)
         total[rows] = gradient
         return cc, total
@@ -318,7 +331,8 @@ def fit_map_levels(
         if cancelled():
             return
         if level == DOMAINS:
-            yield fit_domain(model, segments, target, heavy_atoms(model), cancelled=cancelled)
+            rows = heavy_atoms(model)
+            yield fit_domain(model, segments, target, rows, occupancies(model, rows), cancelled=cancelled)
             continue
         if not networks:
             networks += [ElasticNetwork(model.coords[ca]), ElasticNetwork(model.coords[ca], give_way=GIVE_WAY)]

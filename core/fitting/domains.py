@@ -77,23 +77,23 @@ def dynamic_domains(ca: np.ndarray) -> np.ndarray:
     return smaller if SMALLEST <= smaller.sum() <= n - SMALLEST else none
 
 
-def fit_domain(model: EditableModel, segments: Sequence[int], target: MapTarget, heavy: np.ndarray, *,
-               cancelled: Callable[[], bool] = lambda: False) -> LevelFit:
+def fit_domain(model: EditableModel, segments: Sequence[int], target: MapTarget, heavy: np.ndarray,
+               occupancy: np.ndarray, *, cancelled: Callable[[], bool] = lambda: False) -> LevelFit:
     """Move the smaller dynamic domain of ``segments`` (one chain, in order) as a rigid body
     into ``target`` (a :class:`~core.fitting.density.MapTarget`) seen at :data:`RESOLUTION`,
     where that gains :data:`GAIN` of correlation; ``heavy`` are the rows of the model's atoms
-    the map shows. The edits (one per segment moved, none where nothing moved) are applied
+    the map shows, ``occupancy`` how much of each (:func:`core.fitting.density.occupancies`). The edits (one per segment moved, none where nothing moved) are applied
     to ``model``; the score is the correlation at :data:`RESOLUTION` after the stage."""
     began = time.perf_counter()
     at = target.blurred(RESOLUTION)
     residues = np.concatenate([model.segments[s].residue_index for s in segments])
     domain = dynamic_domains(model.coords[ca_rows(model.structure)[residues]])
     coords = model.coords[heavy]
-    before = at.correlation(coords)
+    before = at.correlation(coords, occupancy)
     if not domain.any() or cancelled():
         return LevelFit(DOMAINS, 0, before, time.perf_counter() - began, (), at.resolution)
     moving = np.isin(model.structure.atom_residue[heavy], residues[domain])
-    turn, shift, cc = _rigid_fit(at, coords, moving, cancelled)
+    turn, shift, cc = _rigid_fit(at, coords, occupancy, moving, cancelled)
     if cc - before < GAIN or cancelled():
         return LevelFit(DOMAINS, 0, before, time.perf_counter() - began, (), at.resolution)
     pivot = coords[moving].mean(axis=0)
@@ -116,7 +116,7 @@ def fit_domain(model: EditableModel, segments: Sequence[int], target: MapTarget,
             model.apply(edit)
             edits.append(edit)
             n_points += int(owned.sum())
-    score = at.correlation(model.coords[heavy])
+    score = at.correlation(model.coords[heavy], occupancy)
     return LevelFit(DOMAINS, n_points, score, time.perf_counter() - began, tuple(edits), at.resolution,
                     motion=f"{int(domain.sum())} residues turned {np.degrees(turn.magnitude()):.0f}° and moved "
                            f"{np.linalg.norm(shift):.1f} Å (the smaller dynamic domain)")
@@ -131,8 +131,8 @@ def _owned_points(ribbon: Ribbon, domain: np.ndarray) -> np.ndarray:
     return domain[nearest]
 
 
-def _rigid_fit(at: MapTarget, coords: np.ndarray, moving: np.ndarray, cancelled: Callable[[], bool]
-               ) -> tuple[Rotation, np.ndarray, float]:
+def _rigid_fit(at: MapTarget, coords: np.ndarray, occupancy: np.ndarray, moving: np.ndarray,
+               cancelled: Callable[[], bool]) -> tuple[Rotation, np.ndarray, float]:
     """The rotation (about the moving atoms' centroid), translation and correlation of the
     best rigid placement of ``coords[moving]`` in ``at`` from the :data:`TURNS` starts."""
     pivot = coords[moving].mean(axis=0)
@@ -144,7 +144,7 @@ def _rigid_fit(at: MapTarget, coords: np.ndarray, moving: np.ndarray, cancelled:
         placed = coords.copy()
         turned = rotation.apply(arm)
         placed[moving] = turned + pivot + x[3:]
-        cc, gradient = at.gradient(placed)
+        cc, gradient = at.gradient(placed, occupancy)
         if cc > best["cc"]:
             best.update(cc=cc, x=x.copy())
         pull = gradient[moving]

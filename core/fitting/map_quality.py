@@ -55,10 +55,11 @@ class MapQuality:
         return text + f"; {len(self.outside)} residue(s) outside the density{listed}"
 
 
-def map_quality(target: MapTarget, coords: np.ndarray, residue_of_atom: np.ndarray, residues: int) -> MapQuality:
-    """The fit of atoms at ``coords`` (n, 3) in ``target``; ``residue_of_atom`` (n,) gives each
-    atom's residue in ``range(residues)``."""
-    model = target.density(coords).ravel()
+def map_quality(target: MapTarget, coords: np.ndarray, residue_of_atom: np.ndarray, residues: int,
+                occupancy: np.ndarray | None = None) -> MapQuality:
+    """The fit of atoms at ``coords`` (n, 3) in ``target``, each weighted by its ``occupancy``
+    (n,; default 1); ``residue_of_atom`` (n,) gives each atom's residue in ``range(residues)``."""
+    model = target.density(coords, occupancy).ravel()
     mapped = target.target.ravel()
     cc_box = _cc(model - model.mean(), mapped)
     distance, nearest = cKDTree(coords).query(target.points(), distance_upper_bound=mask_radius(target.resolution))

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from core.fitting.density import gaussian_sigma, heavy_atoms
+from core.fitting.density import gaussian_sigma, heavy_atoms, occupancies
 from core.protein.model import EditableModel
 from core.protein.structure import Structure
 from core.surfaces.volume import DensityMap, model_density
@@ -26,25 +26,29 @@ def _box(coords: np.ndarray, margin: float) -> tuple[np.ndarray, tuple[int, ...]
 
 
 def molmap(structure: Structure, resolution: float, margin: float = MARGIN) -> DensityMap:
-    """The heavy atoms counted on a 1 Å grid, blurred to ``resolution`` Å (Chimera's molmap width)."""
-    coords = structure.coords[heavy_atoms(EditableModel(structure))]
+    """The heavy atoms counted on a 1 Å grid (each by its occupancy), blurred to ``resolution``
+    Å (Chimera's molmap width)."""
+    model = EditableModel(structure)
+    rows = heavy_atoms(model)
+    coords = structure.coords[rows]
     origin, shape = _box(coords, margin)
     grid = np.zeros(shape)
-    np.add.at(grid, tuple(np.round(coords - origin).astype(int).T), 1.0)
+    np.add.at(grid, tuple(np.round(coords - origin).astype(int).T), occupancies(model, rows))
     values = ndimage.gaussian_filter(grid, gaussian_sigma(resolution)).astype(np.float32)
     return DensityMap(values, origin, np.eye(3))
 
 
 def xray_like(structure: Structure, resolution: float, noise: float = 0.3, seed: int = 0,
               margin: float = MARGIN) -> DensityMap:
-    """Each heavy atom a Gaussian of its electrons blurred by its B-factor (σ² = B / 8π²) on a
+    """Each heavy atom a Gaussian of its electrons (times its occupancy) blurred by its B-factor (σ² = B / 8π²) on a
     1 Å grid, the Fourier transform cut sharply at 1/``resolution`` (the ripples of a real
     map), and white noise of ``noise`` times the map's standard deviation."""
-    rows = heavy_atoms(EditableModel(structure))
+    model = EditableModel(structure)
+    rows = heavy_atoms(model)
     coords = structure.coords[rows]
     origin, shape = _box(coords, margin)
     grid = np.zeros(shape)
-    weight = np.array([ELECTRONS.get(e.upper(), 6) for e in structure.atoms.element[rows]], dtype=float)
+    weight = np.array([ELECTRONS.get(e.upper(), 6) for e in structure.atoms.element[rows]]) * occupancies(model, rows)
     sigma = np.sqrt(np.maximum(structure.atoms.b_factor[rows], 2.0) / (8 * np.pi**2))
     for width in np.unique(np.round(sigma, 1)):  # atoms of like B-factor blurred together
         layer = np.zeros(shape)

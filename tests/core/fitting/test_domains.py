@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.fitting.density import MapTarget, fit_map, heavy_atoms
+from core.fitting.density import MapTarget, fit_map, heavy_atoms, occupancies
 from core.fitting.domains import DOMAINS, GAIN, dynamic_domains, fit_domain
 from core.fitting.simulated_maps import molmap, xray_like
 from core.geometry.validation import validate
@@ -55,8 +55,8 @@ def test_the_lid_turns_into_the_other_conformations_map_as_a_rigid_body(
     model = EditableModel(start)
     heavy = heavy_atoms(model)
     target = MapTarget(xray_like(end, 10.0), 10.0, model.coords[heavy])
-    before = target.blurred(20.0).correlation(model.coords[heavy])
-    stage = fit_domain(model, [0], target, heavy)
+    before = target.blurred(20.0).correlation(model.coords[heavy], occupancies(model, heavy))
+    stage = fit_domain(model, [0], target, heavy, occupancies(model, heavy))
     assert stage.level == DOMAINS and stage.name == "domains" and "turned" in stage.motion
     assert stage.score > before + GAIN
     assert _rmsd(_ca(start), _ca(end)) > 9.0
@@ -79,7 +79,8 @@ def test_a_model_in_its_own_density_moves_no_domain() -> None:
     structure = read_structure(DATA / OPEN)
     model = EditableModel(structure)
     heavy = heavy_atoms(model)
-    stage = fit_domain(model, [0], MapTarget(molmap(structure, 10.0), 10.0, model.coords[heavy]), heavy)
+    target = MapTarget(molmap(structure, 10.0), 10.0, model.coords[heavy])
+    stage = fit_domain(model, [0], target, heavy, occupancies(model, heavy))
     assert not stage.edits and stage.motion is None and stage.control_points == 0
     assert np.array_equal(model.coords, structure.coords)
 

@@ -3,9 +3,11 @@ ways by other code (molmap-style, X-ray-like with its Fourier ripples and noise,
 electron density), at 3, 6 and 10 Å, in tight and loose boxes, and into maps written by
 mrcfile in every convention of the CCP4/MRC format, read back from the file.
 
-The bound is 0.5 Å of Cα rmsd, except at 10 Å in the maps made with B-factors and
-electrons (X-ray-like, gemmi's), where the fit moves the model 0.7-1.0 Å today, a known gap:
-there the bound is 1.1 Å."""
+The bound is 0.5 Å of Cα rmsd, except at 10 Å in the X-ray-like maps (cut sharply in
+Fourier space, with noise), where the fit moves the model 0.7 Å today, a known gap (the
+levels 0.44 Å, the refinement residue by residue into the ripples the rest): there the
+bound is 1.0 Å. (Before the model's density weighted each atom by its occupancy, gemmi's
+map at 10 Å drew ubiquitin's C-terminal tail, occupied 25-45%, 2 Å out of place.)"""
 
 from pathlib import Path
 
@@ -53,7 +55,7 @@ def ubiquitin() -> Structure:
 @pytest.mark.parametrize("made", MAKERS)
 def test_a_model_stays_in_its_own_density(ubiquitin: Structure, made: str, resolution: float, box: str) -> None:
     density = MAKERS[made](ubiquitin, resolution, margin=BOXES[box])
-    bound = 1.1 if resolution == 10.0 and made != "molmap" else 0.5
+    bound = 1.0 if resolution == 10.0 and made == "x-ray-like" else 0.5
     assert fitted_moves(ubiquitin, density, resolution) < bound
 
 

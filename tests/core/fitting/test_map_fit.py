@@ -204,3 +204,20 @@ def test_a_refinement_cancelled_stops_at_once_with_the_best_point_it_reached(adk
     assert len(evaluations) == 15  # no evaluation after Cancel
     whole = after(None)
     assert len(evaluations) > 50 and start < stopped < whole
+
+
+def test_a_partly_occupied_atom_weighs_its_occupancy_in_the_models_density(adk: EditableModel) -> None:
+    """As a map shows it: the density of atoms at half occupancy is half theirs, and the
+    gradient of the CC so weighted is its derivative."""
+    target = _own_map(adk)
+    coords = adk.coords[heavy_atoms(adk)] + np.random.default_rng(3).normal(scale=0.5, size=(len(heavy_atoms(adk)), 3))
+    occupancy = np.random.default_rng(4).choice([0.25, 0.5, 1.0], len(coords))
+    assert np.allclose(target.density(coords, np.full(len(coords), 0.5)), 0.5 * target.density(coords))
+    cc, gradient = target.gradient(coords, occupancy)
+    assert cc == target.correlation(coords, occupancy) != target.correlation(coords)
+    for atom in np.argsort(-np.linalg.norm(gradient, axis=1))[:5]:
+        for axis in range(3):
+            step = np.zeros_like(coords)
+            step[atom, axis] = 1e-4
+            numeric = (target.correlation(coords + step, occupancy) - target.correlation(coords - step, occupancy)) / 2e-4
+            assert numeric == pytest.approx(gradient[atom, axis], rel=0.05, abs=1e-7)
