@@ -118,8 +118,8 @@ def fit_domain(model: EditableModel, segments: Sequence[int], target: MapTarget,
             n_points += int(owned.sum())
     score = at.correlation(model.coords[heavy], occupancy)
     return LevelFit(DOMAINS, n_points, score, time.perf_counter() - began, tuple(edits), at.resolution,
-                    motion=f"{int(domain.sum())} residues turned {np.degrees(turn.magnitude()):.0f}° and moved "
-                           f"{np.linalg.norm(shift):.1f} Å (the smaller dynamic domain)")
+                    motion=f"the smaller dynamic domain, {int(domain.sum())} residues, turned "
+                           f"{np.degrees(turn.magnitude()):.0f}° and moved {np.linalg.norm(shift):.1f} Å")
 
 
 def _owned_points(ribbon: Ribbon, domain: np.ndarray) -> np.ndarray:

@@ -189,7 +189,7 @@ def test_fit_to_map_coarse_to_fine_is_one_step_a_level_and_a_regularization(wind
     assert [level for level, _ in fitted] == [DOMAINS, 0, 1, 2, 3]
     steps, index = window.rw.history()
     assert index == 7 and steps[0].startswith("Fit to map: the domains (CC ")  # the LID or NMP domain turned
-    assert "residues turned" in steps[0]
+    assert "the smaller dynamic domain, 5" in steps[0] and "residues, turned" in steps[0]
     assert [s.split(" (")[0] for s in steps[1:5]] == [f"Fit to map at level {k}" for k in range(4)]
     assert steps[5] == "Regularize the fit to map"
     assert steps[6] == "Refine the fit to map (each residue, side chains)"
