@@ -60,7 +60,7 @@ def xray_like(structure: Structure, resolution: float, noise: float = 0.3, seed:
     spectrum[np.sqrt(sum(f**2 for f in k)) > 1.0 / resolution] = 0.0
     values = np.fft.irfftn(spectrum, shape, axes=(0, 1, 2))
     values += noise * values.std() * np.random.default_rng(seed).standard_normal(shape)
-    return DensityMap(values.astype(np.float32), origin, np.eye(3))
+    return DensityMap(values.astype(np.float32), origin, np.eye(3), resolution=resolution, cut_sharply=True)
 
 
 def gemmi_like(structure: Structure, resolution: float, margin: float = MARGIN) -> DensityMap:

@@ -105,4 +105,5 @@ def _map(mtz: gemmi.Mtz, columns: tuple[str, str]) -> DensityMap:
     grid = mtz.transform_f_phi_to_map(*columns, sample_rate=SAMPLE_RATE)
     values = np.array(grid.array, dtype=np.float32)
     axes = (np.array(grid.unit_cell.orth.mat.tolist()) / np.array(values.shape)).T
-    return DensityMap(values, np.zeros(3), axes, periodic=True, resolution=float(mtz.resolution_high()))
+    return DensityMap(values, np.zeros(3), axes, periodic=True, resolution=float(mtz.resolution_high()),
+                      cut_sharply=True)

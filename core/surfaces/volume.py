@@ -48,6 +48,8 @@ class DensityMap:
         orthogonal cell).
     periodic : whether the grid is one unit cell of a crystal, repeated through space.
     resolution : Å, the map's resolution where its file says it, else None.
+    cut_sharply : whether its Fourier transform ends sharply at ``resolution`` (a map made
+        from a crystal's coefficients), so that it ripples around dense parts.
     """
 
     values: NDArray[np.float32]
@@ -55,6 +57,7 @@ class DensityMap:
     axes: NDArray[np.float64]
     periodic: bool = False
     resolution: float | None = None
+    cut_sharply: bool = False
 
     @cached_property
     def _coefficients(self) -> list:

@@ -11,6 +11,7 @@ from scipy import ndimage, sparse
 from core.fitting.density import MapTarget, atom_correlation, fit_map, gaussian_sigma, heavy_atoms, refine
 from core.fitting.real_space import ResidueBodies, refine_real_space
 from core.fitting.side_chains import side_chain_rotors
+from core.fitting.simulated_maps import xray_like
 from core.geometry.topology import topology
 from core.geometry.validation import validate
 from core.protein.model import EditableModel
@@ -220,4 +221,28 @@ def test_a_partly_occupied_atom_weighs_its_occupancy_in_the_models_density(adk: 
             step = np.zeros_like(coords)
             step[atom, axis] = 1e-4
             numeric = (target.correlation(coords + step, occupancy) - target.correlation(coords - step, occupancy)) / 2e-4
+            assert numeric == pytest.approx(gradient[atom, axis], rel=0.05, abs=1e-7)
+
+
+def test_for_a_map_cut_sharply_the_models_density_is_cut_the_same_way(adk: EditableModel) -> None:
+    """Its transform ends at 1/resolution, as the map's does (it ripples as the map does),
+    and the gradient of the CC is still its derivative (the filter is its own adjoint)."""
+    rows = heavy_atoms(adk)
+    density = xray_like(adk.structure, 8.0, noise=0.0)
+    assert density.cut_sharply and density.resolution == 8.0
+    target = MapTarget(density, 8.0, adk.coords[rows])
+    model = target.density(adk.coords[rows])
+    frequency = np.meshgrid(*(np.fft.fftfreq(n, target.spacing) for n in model.shape), indexing="ij")
+    beyond = np.sqrt(sum(f**2 for f in frequency)) > 1.0 / 8.0 + 1.0 / (min(model.shape) * target.spacing)
+    power = np.abs(np.fft.fftn(model)) ** 2
+    assert power[beyond].sum() < 0.02 * power.sum()  # (what is left: the cut box's edges)
+    assert target.correlation(adk.coords[rows]) > 0.99 > MapTarget(
+        DensityMap(density.values, density.origin, density.axes), 8.0, adk.coords[rows]).correlation(adk.coords[rows])
+    coords = adk.coords[rows] + np.random.default_rng(6).normal(scale=0.5, size=(len(rows), 3))
+    cc, gradient = target.gradient(coords)
+    for atom in np.argsort(-np.linalg.norm(gradient, axis=1))[:4]:
+        for axis in range(3):
+            step = np.zeros_like(coords)
+            step[atom, axis] = 1e-4
+            numeric = (target.correlation(coords + step) - target.correlation(coords - step)) / 2e-4
             assert numeric == pytest.approx(gradient[atom, axis], rel=0.05, abs=1e-7)
