@@ -64,8 +64,9 @@ from scipy.spatial.transform import Rotation
 
 from core.analysis.superpose import superpose
 from core.fitting.conformation import fit_conformation, pair_segments
-from core.fitting.density import MapTarget, fit_map, heavy_atoms, occupancies
+from core.fitting.density import fit_map
 from core.fitting.domains import DOMAINS
+from core.fitting.map_target import MapTarget, heavy_atoms, occupancies
 from core.fitting.simulated_maps import gemmi_like, molmap, xray_like
 from core.geometry.validation import validate
 from core.protein.model import EditableModel

@@ -8,7 +8,7 @@ residues spread over the structure. A contour is what the editor does when the c
 map around the centre, marching cubes at 1 σ, the triangles beyond the radius dropped, the
 mesh into the drawn pyvista data. Target: a 30 Å box (radius 15 Å) within 50 ms. The
 correlation is the one the Map dock shows during a drag, of the first segment's heavy atoms
-(:class:`core.fitting.density.MapTarget`). Medians over the centres, in milliseconds.
+(:class:`core.fitting.map_target.MapTarget`). Medians over the centres, in milliseconds.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import numpy as np
 import pyvista as pv
 
 from app.polydata import to_polydata
-from core.fitting.density import MapTarget
+from core.fitting.map_target import MapTarget
 from core.protein.reading import read_structure
 from core.protein.structure import ca_rows
 from core.surfaces.volume import model_density

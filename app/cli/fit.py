@@ -23,16 +23,16 @@ from core.fitting.conformation import (
     fold_similarity,
     pair_segments,
 )
-from core.fitting.density import (
+from core.fitting.density import fit_map
+from core.fitting.domains import DOMAINS
+from core.fitting.map_quality import MapQuality, map_quality
+from core.fitting.map_target import (
     RESOLUTION,
     MapTarget,
     file_resolution,
-    fit_map,
     heavy_atoms,
     occupancies,
 )
-from core.fitting.domains import DOMAINS
-from core.fitting.map_quality import MapQuality, map_quality
 from core.fitting.morph import morph_frames
 from core.fitting.settle import FitResult
 from core.geometry.validation import validate

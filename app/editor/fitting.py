@@ -29,8 +29,9 @@ from app.editor.document import Document
 from app.editor.scene.overlay import Compared, chain_segments
 from core.fitting.coarse_to_fine import LevelFit, fit_levels
 from core.fitting.conformation import SAME_FOLD, fold_similarity, pair_segments
-from core.fitting.density import MapTarget, fit_map_levels, heavy_atoms, refine
+from core.fitting.density import fit_map_levels, refine
 from core.fitting.domains import DOMAINS
+from core.fitting.map_target import MapTarget, heavy_atoms
 from core.fitting.settle import settle
 from core.protein.model import Edit
 from core.surfaces.volume import DensityMap

@@ -1,7 +1,7 @@
 """The live correlation of the edited segment with the open map, and its judgement.
 
 The segment's heavy atoms, blurred to the map's resolution, are correlated with the map in
-a box around them (:class:`core.fitting.density.MapTarget`, built again when the segment,
+a box around them (:class:`core.fitting.map_target.MapTarget`, built again when the segment,
 the map or the resolution changes). Edits (a drag's previews included) ask for a new value;
 it is computed between events, at most every :data:`INTERVAL_MS`. Once the edits pause for
 :data:`JUDGE_MS` (a drag's previews never: only when it ends), the segment is judged as a modeller judges a fit
@@ -25,8 +25,8 @@ from app.editor.document import Document
 from app.editor.scene.map_mesh import MapMesh
 
 if TYPE_CHECKING:
-    from core.fitting.density import MapTarget
     from core.fitting.map_quality import MapQuality
+    from core.fitting.map_target import MapTarget
 
 INTERVAL_MS = 100
 """Shortest time between two correlations."""
@@ -75,8 +75,8 @@ class LiveCorrelation(QObject):
         maps.opened.connect(self._map_opened)
 
     def set_resolution(self, resolution: float) -> None:
-        """The map's resolution, Å (in :data:`core.fitting.density.RESOLUTION`, else ValueError)."""
-        from core.fitting.density import RESOLUTION  # the fitting code loads with the first map
+        """The map's resolution, Å (in :data:`core.fitting.map_target.RESOLUTION`, else ValueError)."""
+        from core.fitting.map_target import RESOLUTION  # the fitting code loads with the first map
 
         if not RESOLUTION[0] <= resolution <= RESOLUTION[1]:
             raise ValueError(f"resolution must be in [{RESOLUTION[0]:g}, {RESOLUTION[1]:g}] Å; got {resolution:g}")
@@ -111,7 +111,7 @@ class LiveCorrelation(QObject):
         return self.quality.summary(list(document.structure.segments[document.segment].labels))
 
     def _map_opened(self) -> None:
-        from core.fitting.density import file_resolution
+        from core.fitting.map_target import file_resolution
 
         given = file_resolution(self.maps.density)
         if given is None:
@@ -137,7 +137,7 @@ class LiveCorrelation(QObject):
 
     def _segment_target(self) -> MapTarget:
         """The map around the edited segment (raises MapError where the two do not overlap)."""
-        from core.fitting.density import (  # (loads with the first map)
+        from core.fitting.map_target import (  # (loads with the first map)
             MapTarget,
             heavy_atoms,
             occupancies,

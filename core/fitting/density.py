@@ -49,15 +49,14 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import replace
-from functools import cached_property
 
 import numpy as np
-from scipy import fft, ndimage
 from scipy.spatial import cKDTree
 
 from core.curves.splines import spline_space
 from core.fitting.coarse_to_fine import LevelFit, pushed_to_finest
 from core.fitting.domains import DOMAINS, fit_domain
+from core.fitting.map_target import RESOLUTION, MapTarget, heavy_atoms, occupancies
 from core.fitting.real_space import refine_real_space
 from core.fitting.settle import FIT_ITERATIONS, FitResult, settle
 from core.fitting.stoppable import minimize_until_cancelled
@@ -65,14 +64,7 @@ from core.geometry.regularize import regularize_region
 from core.geometry.vectors import lengths, pair_gradient
 from core.protein.model import Edit, EditableModel, per_segment
 from core.protein.structure import ca_rows
-from core.surfaces.volume import DensityMap, MapError
 
-SIGMA_PER_RESOLUTION = 1.0 / (np.pi * np.sqrt(2.0))
-"""Gaussian width of an atom per Å of resolution (Chimera's ``molmap``)."""
-RESOLUTION = (2.0, 30.0)
-"""Å: the resolutions a fit takes."""
-MIN_OVERLAP = 0.5
-"""Fewest of the model's atoms that must lie inside the map."""
 ITERATIONS_PER_LEVEL = 60
 STIFFNESS = 0.01
 """CC per Å² of mean squared change of the elastic network's spring lengths."""
@@ -91,209 +83,9 @@ LEVELS_RESOLUTION = 12.0
 """Å: the levels are fitted into the map blurred to this resolution at least, where it is
 finer (:meth:`MapTarget.blurred`, :func:`level_resolution`); the refinement fits into the
 map as it is."""
-CRYSTAL_MASK = 3.0
-"""Å beyond the atoms (and an atom's Gaussian width) that a crystal's map is kept around the
-model for a fit: beyond, its neighbours' density, flattened to the solvent's level (the mean
-of the map at the mask's edge)."""
-CUT_MODEL_FROM = 6.0
-"""Å: a map cut sharply in Fourier space at this resolution or coarser is fitted with the
-model's density cut the same way: its ripples, a resolution wide, span residues and drew
-ubiquitin 0.72 Å out of its own X-ray-like 10 Å map (0.27-0.36 Å cut as the map is); at
-finer cuts they are atomic detail, the Gaussian model does as well (0.17 Å at 3 Å) and is
-five times cheaper on the fine grid (an MTZ map at 2.5 Å)."""
-ATOM_SIGMA = 0.6
-"""Å: an atom's own width in a map cut sharply in Fourier space (B ≈ 30 Å²), before the cut."""
 RESOLUTION_PER_RESIDUE = 2.0
 """Å per residue of a span between a level's control points: the resolution that level
 sees the map at (:func:`level_resolution`; coarser levels see it coarser)."""
-
-
-def file_resolution(density: DensityMap) -> tuple[float, str] | None:
-    """The resolution a fit takes for ``density`` where its file gives one (bounded to
-    :data:`RESOLUTION`), and where it comes from, for people; None where the file gives none."""
-    if density.resolution is None:
-        return None
-    bounded = float(np.clip(density.resolution, *RESOLUTION))
-    return bounded, "the file's" if bounded == density.resolution else f"the file's {density.resolution:.3g} Å, bounded"
-
-
-def gaussian_sigma(resolution: float) -> float:
-    """Å, the Gaussian width of an atom in a map of ``resolution`` Å."""
-    return SIGMA_PER_RESOLUTION * resolution
-
-
-class MapTarget:
-    """A map around a model, resampled on an orthogonal grid, and the model's density on it.
-
-    Parameters
-    ----------
-    density : the map.
-    resolution : Å, the map's resolution (the model's density is blurred to it).
-    around : (n, 3) atom positions the box is built around, Å.
-    margin : Å beyond the atoms (default three Gaussian widths and 5 Å for the motion).
-    """
-
-    def __init__(self, density: DensityMap, resolution: float, around: np.ndarray, margin: float | None = None) -> None:
-        if not RESOLUTION[0] <= resolution <= RESOLUTION[1]:
-            raise ValueError(f"resolution must be in [{RESOLUTION[0]:g}, {RESOLUTION[1]:g}] Å; got {resolution:g}")
-        self.resolution = float(resolution)
-        self.sigma = gaussian_sigma(resolution)
-        cut = density.resolution if density.cut_sharply else None
-        self.cut = cut if cut is not None and cut >= CUT_MODEL_FROM else None
-        """Å: where the map's transform ends sharply, the model's density cut there too (from
-        :data:`CUT_MODEL_FROM` on), or None."""
-        self.spacing = float(np.clip(resolution / 4.0, 0.5, 2.5))
-        self._around, self._margin = around, margin
-        self._blurred: dict[float, MapTarget] = {}
-        margin = 3.0 * self.sigma + 5.0 if margin is None else margin
-        inside = density.covers(around)
-        if inside.mean() < MIN_OVERLAP:
-            raise MapError(f"the map does not overlap the model: {inside.mean():.0%} of its atoms lie inside the map "
-                           f"(at least {MIN_OVERLAP:.0%} must)")
-        self.origin = around.min(axis=0) - margin
-        self.shape = tuple(np.ceil((around.max(axis=0) + margin - self.origin) / self.spacing).astype(int) + 1)
-        values = density.interpolate(self.points()).reshape(self.shape)
-        if density.periodic:  # a crystal's map: the neighbours' density off, the model fitted into its own
-            radius, distance = CRYSTAL_MASK + self.sigma, self.distances(around)
-            edge = (distance > radius - 1.0) & (distance <= radius)  # the solvent's level, about
-            values = np.where(distance <= radius, values, values[edge].mean())
-        self._target = values - values.mean()
-        self._target_norm = _norm(self._target)
-        if self._target_norm == 0.0:
-            raise MapError("the map is flat around the model: nothing to fit into")
-
-    @property
-    def target(self) -> np.ndarray:
-        """The map on the grid, less its mean."""
-        return self._target
-
-    def points(self) -> np.ndarray:
-        """(n, 3) the grid's points, Å, in the order of its flattened values."""
-        return self.origin + np.stack(np.indices(self.shape), axis=-1).reshape(-1, 3) * self.spacing
-
-    def distances(self, coords: np.ndarray) -> np.ndarray:
-        """Å from each grid point to the nearest of the atoms at ``coords`` (to half a grid
-        step), on the grid."""
-        occupied = np.zeros(self.shape, dtype=bool)
-        index = np.round((coords - self.origin) / self.spacing).astype(int)
-        index = index[np.all((index >= 0) & (index < self.shape), axis=1)]
-        occupied[tuple(index.T)] = True
-        return ndimage.distance_transform_edt(~occupied, sampling=self.spacing)
-
-    def blurred(self, resolution: float) -> MapTarget:
-        """The map blurred to a coarser ``resolution`` (Å) and the model's density with it,
-        on a grid to suit (itself where ``resolution`` is not coarser). The map is blurred
-        on this target's grid, then resampled."""
-        if resolution <= self.resolution:
-            return self
-        if resolution not in self._blurred:
-            blur = np.sqrt(gaussian_sigma(resolution) ** 2 - self.sigma**2) / self.spacing
-            values = ndimage.gaussian_filter(self._target, blur, mode="nearest")
-            blurred = DensityMap(values, self.origin, self.spacing * np.eye(3), resolution=self.cut,
-                                 cut_sharply=self.cut is not None)
-            self._blurred[resolution] = MapTarget(blurred, resolution, self._around, self._margin)
-        return self._blurred[resolution]
-
-    def density(self, coords: np.ndarray, occupancy: np.ndarray | None = None) -> np.ndarray:
-        """The model's density on the grid for atoms at ``coords`` (n, 3), each weighted by
-        its ``occupancy`` (n,; default 1), as a map shows a partly occupied atom."""
-        flat, keep, weight, _ = self._corners(coords)
-        if occupancy is not None:
-            weight = weight * occupancy
-        spread = np.bincount(flat[keep], weight[keep], int(np.prod(self.shape)))
-        return self._blur(spread.reshape(self.shape).astype(np.float64))  # integers when no atom is on the grid
-
-    def correlation(self, coords: np.ndarray, occupancy: np.ndarray | None = None) -> float:
-        """CC about the mean of the model's density (:meth:`density`) with the map."""
-        model = self.density(coords, occupancy)
-        model -= model.mean()
-        norm = _norm(model)
-        return float(np.sum(model * self._target) / (norm * self._target_norm)) if norm > 0 else 0.0
-
-    def gradient(self, coords: np.ndarray, occupancy: np.ndarray | None = None) -> tuple[float, np.ndarray]:
-        """The CC (as :meth:`correlation`) and its gradient (n, 3) with respect to each atom's
-        position (1/Å).
-
-        The density spreads each atom trilinearly and blurs; both are adjoint to what the
-        gradient does (the blur is symmetric, trilinear spreading the transpose of trilinear
-        interpolation), so the exact gradient is that of the trilinear interpolant of the
-        blurred ∂CC/∂density at each atom."""
-        model = self.density(coords, occupancy)
-        model -= model.mean()
-        norm = _norm(model)
-        if norm == 0.0:
-            return 0.0, np.zeros_like(coords)
-        cc = float(np.sum(model * self._target) / (norm * self._target_norm))
-        field = self._blur(self._target / (norm * self._target_norm) - cc * model / norm**2).ravel()
-        flat, keep, _, slopes = self._corners(coords)
-        gradient = np.einsum("cn,cni->ni", np.where(keep, field[flat], 0.0), slopes) / self.spacing
-        return cc, gradient if occupancy is None else gradient * occupancy[:, None]
-
-    def _blur(self, grid: np.ndarray) -> np.ndarray:
-        """The model's density from its atoms spread on the grid: blurred by a Gaussian of
-        the resolution's width, or for a map cut sharply in Fourier space, cut the same way
-        (each atom :data:`ATOM_SIGMA` wide, and as much wider as the resolution asked is
-        coarser than the cut), so that it ripples as the map does. Either is its own adjoint."""
-        if self.cut is None:
-            return ndimage.gaussian_filter(grid, self.sigma / self.spacing, mode="constant", truncate=3.0)
-        padded = np.pad(grid, [(self._pad, m - n - self._pad) for n, m in zip(self.shape, self._padded)])
-        filtered = fft.irfftn(fft.rfftn(padded) * self._cut_filter, self._padded, axes=(0, 1, 2))
-        return filtered[tuple(slice(self._pad, self._pad + n) for n in self.shape)]
-
-    @cached_property
-    def _pad(self) -> int:
-        return int(np.ceil(2.0 * self.cut / self.spacing))  # the ripples' reach, kept from wrapping around
-
-    @cached_property
-    def _padded(self) -> tuple[int, ...]:
-        return tuple(fft.next_fast_len(n + 2 * self._pad, real=True) for n in self.shape)
-
-    @cached_property
-    def _cut_filter(self) -> np.ndarray:
-        """The transform of the model's blur for a map cut sharply: a Gaussian, zero beyond 1/cut."""
-        shape = self._padded
-        frequency = np.meshgrid(*(np.fft.fftfreq(n, self.spacing) for n in shape[:2]),
-                                np.fft.rfftfreq(shape[2], self.spacing), indexing="ij")
-        squared = sum(f**2 for f in frequency)
-        width = ATOM_SIGMA**2 + max(self.sigma**2 - gaussian_sigma(self.cut) ** 2, 0.0)
-        return np.where(squared <= 1.0 / self.cut**2, np.exp(-2.0 * np.pi**2 * squared * width), 0.0)
-
-    def _corners(self, coords: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """For the 8 grid corners around every atom: the flat index of the corner (8, n),
-        whether it lies on the grid (8, n), the trilinear weight (8, n) and its derivative
-        with respect to the atom's grid coordinates (8, n, 3)."""
-        index = (coords - self.origin) / self.spacing
-        base = np.floor(index).astype(int)
-        frac = index - base
-        factors = np.where(_CORNERS[:, None], frac, 1.0 - frac)  # (8, n, 3)
-        sign = np.where(_CORNERS, 1.0, -1.0)[:, None]
-        x, y, z = factors[..., 0], factors[..., 1], factors[..., 2]
-        slopes = np.stack([sign[..., 0] * y * z, x * sign[..., 1] * z, x * y * sign[..., 2]], axis=-1)
-        at = base + _CORNERS[:, None]
-        keep = np.all((at >= 0) & (at < self.shape), axis=2)
-        flat = np.where(keep, (at[..., 0] * self.shape[1] + at[..., 1]) * self.shape[2] + at[..., 2], 0)
-        return flat, keep, x * y * z, slopes
-
-
-def _norm(grid: np.ndarray) -> float:
-    """The 2-norm of a grid (as a sum: BLAS's, through np.linalg.norm, is slow with its threads busy)."""
-    return float(np.sqrt(np.sum(grid * grid)))
-
-
-_CORNERS = np.array(list(np.ndindex(2, 2, 2)))
-"""The 8 corners of a grid cell, (8, 3) of 0 or 1."""
-
-
-def heavy_atoms(model: EditableModel) -> np.ndarray:
-    """Rows of the model's heavy atoms (no hydrogens, no waters): those a map shows."""
-    atoms = model.structure.atoms
-    return np.flatnonzero(~np.isin(np.char.upper(atoms.element.astype(str)), ("H", "D")) & (atoms.category != "water"))
-
-
-def occupancies(model: EditableModel, rows: np.ndarray) -> np.ndarray:
-    """The occupancy of the atoms at ``rows`` of ``model``, in [0, 1]: how much of each a map
-    shows (a side chain in two conformations, half each; a tail half ordered)."""
-    return np.clip(np.nan_to_num(model.structure.atoms.occupancy[rows], nan=1.0), 0.0, 1.0)
 
 
 def atom_correlation(model: EditableModel, target: MapTarget) -> Callable[[np.ndarray], tuple[float, np.ndarray]]:

@@ -34,7 +34,7 @@ from core.protein.ribbon import Ribbon
 from core.protein.structure import ca_rows
 
 if TYPE_CHECKING:
-    from core.fitting.density import MapTarget
+    from core.fitting.map_target import MapTarget
 
 DOMAINS = -1
 """The "level" of this stage in a fit's levels: before level 0."""
@@ -80,9 +80,10 @@ def dynamic_domains(ca: np.ndarray) -> np.ndarray:
 def fit_domain(model: EditableModel, segments: Sequence[int], target: MapTarget, heavy: np.ndarray,
                occupancy: np.ndarray, *, cancelled: Callable[[], bool] = lambda: False) -> LevelFit:
     """Move the smaller dynamic domain of ``segments`` (one chain, in order) as a rigid body
-    into ``target`` (a :class:`~core.fitting.density.MapTarget`) seen at :data:`RESOLUTION`,
+    into ``target`` (a :class:`~core.fitting.map_target.MapTarget`) seen at :data:`RESOLUTION`,
     where that gains :data:`GAIN` of correlation; ``heavy`` are the rows of the model's atoms
-    the map shows, ``occupancy`` how much of each (:func:`core.fitting.density.occupancies`). The edits (one per segment moved, none where nothing moved) are applied
+    the map shows, ``occupancy`` how much of each (:func:`core.fitting.map_target.occupancies`).
+    The edits (one per segment moved, none where nothing moved) are applied
     to ``model``; the score is the correlation at :data:`RESOLUTION` after the stage."""
     began = time.perf_counter()
     at = target.blurred(RESOLUTION)

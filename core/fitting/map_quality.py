@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from core.fitting.density import MapTarget
+from core.fitting.map_target import MapTarget
 from core.surfaces.volume import DensityMap
 
 OUTSIDE_SIGMA = 1.0

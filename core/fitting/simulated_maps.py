@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from core.fitting.density import gaussian_sigma, heavy_atoms, occupancies
+from core.fitting.map_target import gaussian_sigma, heavy_atoms, occupancies
 from core.protein.model import EditableModel
 from core.protein.structure import Structure
 from core.surfaces.volume import DensityMap, model_density

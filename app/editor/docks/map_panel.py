@@ -168,7 +168,7 @@ class MapPanel(QWidget):
             self.file_text.setText(NO_MAP)
             self.sigma_text.setText(f"{maps.sigma:.1f} σ")
         else:
-            from core.fitting.density import RESOLUTION  # the fitting code loads with the first map
+            from core.fitting.map_target import RESOLUTION  # the fitting code loads with the first map
 
             self.resolution.setRange(*RESOLUTION)
             grid = " × ".join(map(str, density.values.shape))

@@ -10,7 +10,7 @@ from scipy import ndimage
 
 from app.main import main
 from core.analysis.superpose import superpose
-from core.fitting.density import gaussian_sigma
+from core.fitting.map_target import gaussian_sigma
 from core.fitting.settle import MIN_MARGIN
 from core.protein.reading import read_structure
 from core.protein.structure import ca_rows

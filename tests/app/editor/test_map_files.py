@@ -12,11 +12,15 @@ from PySide6.QtWidgets import QInputDialog
 from pytestqt.qtbot import QtBot
 
 from app.editor.main_window import MainWindow
-from app.editor.scene.map_mesh import DIFFERENCE_ACTORS, DIFFERENCE_COLOURS, RECONTOUR_MS
-from core.fitting.density import RESOLUTION
+from app.editor.scene.map_mesh import (
+    DIFFERENCE_ACTORS,
+    DIFFERENCE_COLOURS,
+    RECONTOUR_MS,
+)
+from core.fitting.map_target import RESOLUTION
 from core.protein.reading import read_atoms
 from core.surfaces.volume import model_density
-from tests.conftest import DATA, D_MIN, MISSING, write_mrc, write_mtz
+from tests.conftest import D_MIN, DATA, MISSING, write_mrc, write_mtz
 
 
 @pytest.fixture

@@ -23,8 +23,8 @@ from app.editor.main_window import MainWindow
 from app.editor.map_correlation import INTERVAL_MS, JUDGE_MS
 from app.editor.scene.map_mesh import RECONTOUR_MS
 from core.analysis.superpose import superpose
-from core.fitting.density import gaussian_sigma
 from core.fitting.domains import DOMAINS
+from core.fitting.map_target import gaussian_sigma
 from core.geometry.validation import validate
 from core.protein.reading import read_structure
 from core.protein.structure import ca_rows

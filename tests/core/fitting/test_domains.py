@@ -7,8 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.fitting.density import MapTarget, fit_map, heavy_atoms, occupancies
+from core.fitting.density import fit_map
 from core.fitting.domains import DOMAINS, GAIN, dynamic_domains, fit_domain
+from core.fitting.map_target import MapTarget, heavy_atoms, occupancies
 from core.fitting.simulated_maps import molmap, xray_like
 from core.geometry.validation import validate
 from core.protein.model import EditableModel

@@ -14,8 +14,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.fitting.density import MapTarget, fit_map, heavy_atoms
+from core.fitting.density import fit_map
 from core.fitting.domains import DOMAINS
+from core.fitting.map_target import MapTarget, heavy_atoms
 from core.fitting.simulated_maps import gemmi_like, molmap, xray_like
 from core.geometry.validation import validate
 from core.protein.model import EditableModel

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 from scipy import ndimage, sparse
 
-from core.fitting.density import MapTarget, atom_correlation, fit_map, gaussian_sigma, heavy_atoms, refine
+from core.fitting.density import atom_correlation, fit_map, refine
+from core.fitting.map_target import MapTarget, gaussian_sigma, heavy_atoms
 from core.fitting.real_space import ResidueBodies, refine_real_space
 from core.fitting.side_chains import side_chain_rotors
 from core.fitting.simulated_maps import xray_like

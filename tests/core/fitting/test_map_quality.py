@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.fitting.density import MapTarget, heavy_atoms
 from core.fitting.map_quality import map_quality
+from core.fitting.map_target import MapTarget, heavy_atoms
 from core.fitting.simulated_maps import gemmi_like, molmap, xray_like
 from core.protein.model import EditableModel
 from core.protein.reading import read_structure
