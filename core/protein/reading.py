@@ -14,12 +14,12 @@ import io
 import os
 import stat
 import zlib
-from dataclasses import dataclass
 from pathlib import Path
 
 import gemmi
 import numpy as np
 
+from core.protein.scanning import ScannedModel, scan_model
 from core.protein.segments import (
     atom_residue,
     backbone_runs,
@@ -33,13 +33,6 @@ from core.protein.structure import AtomTable, Structure, StructureError, frozen
 MAX_INPUT_MB = 4096
 """MiB a structure file may hold, decompressed (the largest PDB entries hold a few hundred)."""
 LIMIT_VARIABLE = "RIBBONWAVE_MAX_INPUT_MB"
-_BACKBONE = ("N", "CA", "C", "O")
-_PEPTIDE = (gemmi.PolymerType.PeptideL, gemmi.PolymerType.PeptideD)
-_POLYMER_ELEMENTS = frozenset({"H", "D", "C", "N", "O", "S", "P", "Se"})
-"""The elements of standard amino acids and nucleotides. A file without element columns
-(CHARMM and NAMD write such) leaves gemmi to guess from names: CA as calcium, HG1 as mercury."""
-_CHARMM_HISTIDINES = frozenset({"HSD", "HSE", "HSP"})
-"""CHARMM's names of histidine by protonation, standard residues by another name."""
 
 
 def read_structure(
@@ -298,114 +291,3 @@ def _fill_author_columns(block: gemmi.cif.Block) -> None:
 
 def _info(st: gemmi.Structure, key: str) -> str:
     return st.info[key] if key in st.info else ""
-
-
-@dataclass
-class ScannedModel:
-    """Flat arrays from one pass over a gemmi model; one entry per gemmi residue."""
-
-    coords: np.ndarray  # (n_atoms, 3)
-    chain: list[str]
-    chain_part: np.ndarray  # ordinal of the gemmi chain (a chain id may have several parts)
-    seq: np.ndarray
-    icode: list[str]
-    resname: list[str]
-    protein: np.ndarray  # bool
-    start: np.ndarray
-    stop: np.ndarray
-    backbone: np.ndarray  # (n_res, 4) rows of coords for N, CA, C, O, -1 if missing
-    nucleic: np.ndarray  # bool, polymer nucleotide
-    water: np.ndarray  # bool
-    atom_name: list[str]  # per atom from here on
-    element: list[str]
-    altloc: list[str]
-    b_factor: list[float]
-    occupancy: list[float]
-    n_hetero: int
-    n_water: int
-    n_altloc: int
-
-
-def _element(atom: gemmi.Atom, standard: bool) -> str:
-    """The atom's element; in a standard residue, the first letter of its name where the
-    element gemmi gives is none of a standard residue's (a guess from a name, as above)."""
-    name = atom.element.name
-    if not standard or name in _POLYMER_ELEMENTS:
-        return name
-    letters = atom.name.lstrip("0123456789")  # 1HB, 2HG1: older PDB hydrogen names
-    return letters[:1].upper() if letters[:1].upper() in _POLYMER_ELEMENTS else name
-
-
-def scan_model(model: gemmi.Model) -> ScannedModel:
-    """Walk the model once (chain, residue, atom) and collect everything needed."""
-    xyz: list[tuple[float, float, float]] = []
-    chain, part, seq, icode, resname, protein, start, stop, backbone = ([] for _ in range(9))
-    nucleic, water, atom_name, element, altloc, b_factor, occupancy = ([] for _ in range(7))
-    n_hetero = n_water = n_altloc = 0
-    amino_acid: dict[str, bool] = {}
-    nucleotide: dict[str, bool] = {}
-    standard: dict[str, bool] = {}
-    for k, ch in enumerate(model):
-        peptide_chain = ch.get_polymer().check_polymer_type() in _PEPTIDE
-        for res in ch:
-            if res.name not in amino_acid:
-                tabulated = gemmi.find_tabulated_residue(res.name)
-                amino_acid[res.name] = tabulated.is_amino_acid()
-                nucleotide[res.name] = tabulated.is_nucleic_acid()
-                standard[res.name] = tabulated.is_standard() or res.name in _CHARMM_HISTIDINES
-            first = len(xyz)
-            bb = [-1, -1, -1, -1]
-            conformer = ""
-            for atom in res:
-                p = atom.pos
-                xyz.append((p.x, p.y, p.z))
-                alt = atom.altloc if atom.has_altloc() else ""
-                atom_name.append(atom.name)
-                element.append(_element(atom, standard[res.name]))
-                altloc.append(alt)
-                b_factor.append(atom.b_iso)
-                occupancy.append(atom.occ)
-                n_altloc += alt != ""
-                conformer = conformer or alt
-                if atom.name in _BACKBONE and alt in ("", conformer):
-                    slot = _BACKBONE.index(atom.name)
-                    if bb[slot] < 0:
-                        bb[slot] = len(xyz) - 1
-            if res.is_water():
-                n_water += len(res)
-            elif res.het_flag == "H":
-                n_hetero += len(res)
-            polymer = res.entity_type == gemmi.EntityType.Polymer
-            nucleic.append(polymer and nucleotide[res.name])
-            water.append(res.is_water())
-            chain.append(ch.name)
-            part.append(k)
-            seq.append(res.seqid.num)
-            icode.append(res.seqid.icode.strip())
-            resname.append(res.name)
-            protein.append(polymer and (peptide_chain or amino_acid[res.name]))
-            start.append(first)
-            stop.append(len(xyz))
-            backbone.append(bb)
-    return ScannedModel(
-        coords=np.array(xyz, dtype=np.float64).reshape(-1, 3),
-        chain=chain,
-        chain_part=np.array(part, dtype=np.int64),
-        seq=np.array(seq, dtype=np.int64),
-        icode=icode,
-        resname=resname,
-        protein=np.array(protein, dtype=bool),
-        start=np.array(start, dtype=np.int64),
-        stop=np.array(stop, dtype=np.int64),
-        backbone=np.array(backbone, dtype=np.int64).reshape(-1, 4),
-        nucleic=np.array(nucleic, dtype=bool),
-        water=np.array(water, dtype=bool),
-        atom_name=atom_name,
-        element=element,
-        altloc=altloc,
-        b_factor=b_factor,
-        occupancy=occupancy,
-        n_hetero=n_hetero,
-        n_water=n_water,
-        n_altloc=n_altloc,
-    )

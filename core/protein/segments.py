@@ -22,7 +22,7 @@ from core.protein.structure import (
 )
 
 if TYPE_CHECKING:
-    from core.protein.reading import ScannedModel
+    from core.protein.scanning import ScannedModel
 
 
 @dataclass
