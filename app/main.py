@@ -46,7 +46,7 @@ COMMANDS: dict[str, Command] = {
     "analyze": Command("Cα–C^r deviations over many structures by decomposition step (Carson's Fig. 7)",
                        "app.cli.analysis"),
     "compare": Command("superpose two chains and judge fits on fewer Cα or on low-resolution curves",
-                       "app.cli.analysis"),
+                       "app.cli.compare"),
     "index": Command("descriptors of the low-level curves of every protein chain of many structures, for search",
                      "app.cli.search"),
     "search": Command("the chains of an index of the fold nearest a query's, aligned by structure", "app.cli.search"),

@@ -52,7 +52,7 @@ def analyze(paths: list[Path], out: Path, jobs: int, *options: str) -> float:
 
 def one_process(folder: Path) -> tuple[int, int, float, float]:
     """Files, residues, seconds reading and seconds analysing every file in this process."""
-    from app.cli.analysis import structure_paths
+    from app.cli.batch import structure_paths
 
     structures, reading = [], time.perf_counter()
     for path in structure_paths([folder]):

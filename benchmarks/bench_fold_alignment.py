@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import tmtools
 
-from app.cli.analysis import structure_paths
+from app.cli.batch import structure_paths
 from core.analysis.fold_alignment import align_folds
 from core.protein.reading import read_structure
 

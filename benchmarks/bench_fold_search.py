@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import tmtools
 
-from app.cli.analysis import structure_paths
+from app.cli.batch import structure_paths
 from core.analysis.fold_search import FoldIndex, descriptor_distances, index_path, merge, search
 
 PDB_CHAINS = 600_000

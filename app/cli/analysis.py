@@ -1,9 +1,9 @@
-"""Headless database commands: ``analyze`` (Carson's Fig. 7 over many files) and ``compare``
-(two chains superposed, fits on less data judged on a core set). Core does the science;
-this module reads arguments, runs files in parallel, writes CSV/JSON/PNG and prints.
+"""``ribbonwave analyze``: Carson's Fig. 7 over many files. Core does the science
+(:mod:`core.analysis.database`); this module reads arguments, runs the files in parallel
+(:mod:`app.cli.batch`), writes CSV and PNG and prints.
 
 Output formats are a contract for other programs: the columns of ``summary.csv``,
-``residues.csv`` and ``skipped.csv``, and the field names of ``compare --json``.
+``residues.csv`` and ``skipped.csv``.
 """
 
 from __future__ import annotations
@@ -11,32 +11,21 @@ from __future__ import annotations
 import argparse
 import contextlib
 import csv
-import ctypes
 import functools
 import io
-import json
-import multiprocessing
 import os
-import re
 import shutil
-import signal
-import socket
-import struct
 import sys
 import tempfile
-import urllib.parse
-from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections.abc import Iterator
 from pathlib import Path
-from typing import TypeVar
 
 import numpy as np
 from tqdm import tqdm
 
-from app.arguments import bounded, bounded_list
-from app.cli.structure import load
+from app.arguments import bounded
+from app.cli.batch import batch_arguments, run_tasks, structure_paths
 from app.errors import InputError
-from core.analysis.compare import PAIRINGS, Comparison, compare_chains
 from core.analysis.database import (
     CLASSES,
     MODES,
@@ -53,48 +42,21 @@ from core.analysis.database import (
     analyse_path,
     rms_crossing,
 )
-from core.protein.ribbon import RibbonKind
-from core.protein.structure import BackboneSegment, Structure
 
 SUMMARY_COLUMNS = ("ribbon", "mode", "depth", "class", "n_residues", "rms", "sd")
 RESIDUE_COLUMNS = ("file", "entry", "chain", "curve", "resseq", "icode", "resname", "ss", "class")
 OUTPUTS = ("residues.csv", "summary.csv", "skipped.csv", "fig7.png")
 STAGING_PREFIX = ".analyze-"
 """Outputs are written into a new folder ``OUTDIR/.analyze-PID-XXXXXXXX``, then moved into place."""
-DASK_TIMEOUT = 10.0
-"""Seconds to connect to a Dask scheduler and hear its greeting."""
-DASK_FRAME = struct.Struct("<Q")
-"""A Dask message starts with its length: 8 bytes, little-endian."""
-DASK_GREETING_MAX = 1 << 20
-"""Bytes a scheduler's greeting (its handshake) may take: a few hundred in practice."""
-PR_SET_PDEATHSIG = 1
-"""prctl(2): the signal a process gets when its parent ends."""
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
-STRUCTURE_SUFFIXES = (".pdb", ".ent", ".cif", ".mmcif")
 CA_CA = 3.8
 """Ideal Cα–Cα distance (Å): the rms a coarse curve should stay below (Carson 1996)."""
 PAPER = {2: 2.1, 3: 3.3}
 """Carson's pooled rms (Å) of the peptide-plane ribbon at integer depths 2 and 3."""
 CLASS_COLOURS = {"all": "black", "helix": "tab:red", "sheet": "tab:blue", "other": "tab:gray"}
 RIBBON_TITLES = {"peptide": "peptide-plane ribbon", "calpha": "Cα ribbon"}
-T = TypeVar("T")
 Outcome = tuple[FileAnalysis | SkippedFile, str]
 """A file's analysis (or why it was skipped) and its ``residues.csv`` rows."""
-
-
-# --------------------------------------------------------------------------- analyze
-
-
-def batch_arguments(parser: argparse.ArgumentParser) -> None:
-    """Declare the files of a run over many structures and where it runs (:func:`run_tasks`):
-    ``PATH...``, ``--jobs`` and ``--scheduler``."""
-    parser.add_argument("paths", nargs="+", type=Path, metavar="PATH",
-                        help="structure files or folders (searched recursively for .pdb/.ent/.cif/.mmcif, optionally .gz)")
-    parser.add_argument("--jobs", type=bounded(int, 1, 4096), default=len(os.sched_getaffinity(0)), metavar="N",
-                        help="worker processes (default: all cores)")
-    parser.add_argument("--scheduler", nargs="?", const="local", metavar="ADDRESS",
-                        help="run on a Dask cluster (e.g. tcp://host:8786); without ADDRESS, a local cluster "
-                        "of --jobs workers (needs the 'cluster' extra: dask[distributed])")
 
 
 def analyze_arguments(parser: argparse.ArgumentParser) -> None:
@@ -158,151 +120,10 @@ def run_analyze(args: argparse.Namespace) -> int:
     return 0
 
 
-def structure_paths(paths: list[Path]) -> list[Path]:
-    """The files named, and the structure files inside the folders named (sorted, recursive)."""
-    found: list[Path] = []
-    for path in paths:
-        if path.is_dir():
-            found += sorted(
-                p for p in path.rglob("*")
-                if p.is_file() and not p.name.startswith(".")
-                and p.name.lower().removesuffix(".gz").endswith(STRUCTURE_SUFFIXES)
-            )
-        else:
-            found.append(path)  # a file that cannot be read is reported and skipped later
-    if not found:
-        raise InputError(f"no structure files (.pdb, .ent, .cif, .mmcif, optionally .gz) in {', '.join(map(str, paths))}")
-    return found
-
-
-def run_tasks(task: Callable[[Path], T], paths: list[Path], jobs: int, scheduler: str | None,
-              failed: Callable[[Path, str], T]) -> Iterator[tuple[int, T]]:
-    """(index, ``task(path)``) of every path, in order of completion: in this process
-    (``jobs`` 1), in ``jobs`` worker processes, or on the Dask cluster at ``scheduler``
-    ('local': a private one of ``jobs`` workers). ``task`` must pickle (a top-level function,
-    or a partial of one); a worker that dies gives ``failed(path, reason)``."""
-    if scheduler is not None:
-        yield from _run_dask(task, paths, jobs, scheduler, failed)
-    elif jobs == 1 or len(paths) == 1:
-        for index, path in enumerate(paths):
-            yield index, task(path)
-    else:
-        context = multiprocessing.get_context("spawn")  # no fork of a threaded parent; workers are its children
-        with ProcessPoolExecutor(min(jobs, len(paths)), mp_context=context, initializer=_end_with_parent,
-                                 initargs=(os.getpid(),)) as pool:
-            futures = {pool.submit(task, path): index for index, path in enumerate(paths)}
-            try:
-                for future in as_completed(futures):
-                    index = futures.pop(future)  # hold no finished result longer than needed
-                    yield index, _outcome(future, paths[index], failed)
-            except BaseException:  # Ctrl+C or an error: drop the files not started yet
-                pool.shutdown(cancel_futures=True)
-                raise
-
-
-def _run_dask(task: Callable[[Path], T], paths: list[Path], jobs: int, address: str,
-              failed: Callable[[Path, str], T]) -> Iterator[tuple[int, T]]:
-    try:
-        import dask
-        from dask.distributed import Client, LocalCluster, as_completed as dask_completed
-    except ImportError:
-        raise InputError("--scheduler needs Dask: pip install 'dask[distributed]' (the 'cluster' extra)") from None
-    with contextlib.ExitStack() as stack:
-        try:
-            if address == "local":
-                client = _local_client(stack, LocalCluster, Client, jobs, dask)
-            else:
-                _check_scheduler(address)
-                client = stack.enter_context(Client(address, timeout=DASK_TIMEOUT))
-        except (OSError, ValueError, TimeoutError) as error:
-            raise InputError(f"cannot reach the Dask scheduler {address}: {error}") from None
-        futures = client.map(task, paths, pure=False)
-        index = {future.key: k for k, future in enumerate(futures)}
-        completed = dask_completed(futures)
-        del futures  # a result is released on the cluster once it has been handled
-        for future in completed:
-            k = index.pop(future.key)
-            yield k, _outcome(future, paths[k], failed)
-
-
-def _local_client(stack: contextlib.ExitStack, local_cluster: type, client: type, jobs: int, dask: object) -> object:
-    """A client of a cluster on this machine that only this process can use: TLS with a
-    certificate made for this run (no other user can submit tasks to it), on 127.0.0.1,
-    with the HTTP servers of the scheduler and the workers stopped."""
-    try:
-        from distributed.security import Security
-
-        security = Security.temporary()
-    except ImportError:
-        raise InputError("--scheduler needs the 'cryptography' package for a private local cluster: "
-                         "pip install 'ribbonwave[cluster]'") from None
-    stack.enter_context(dask.config.set({"distributed.scheduler.http.routes": [],
-                                         "distributed.worker.http.routes": []}))
-    cluster = stack.enter_context(local_cluster(
-        n_workers=jobs, threads_per_worker=1, processes=True, protocol="tls", security=security, host="127.0.0.1",
-        dashboard_address=None, worker_dashboard_address=None))
-    cluster.scheduler.http_server.stop()
-    connected = stack.enter_context(client(cluster, security=security, timeout=DASK_TIMEOUT))
-    connected.run(_stop_http_server)
-    return connected
-
-
-def _stop_http_server(dask_worker: object) -> None:
-    """Run on each worker of the local cluster: no HTTP endpoint (metrics, health) on it."""
-    dask_worker.http_server.stop()
-
-
-def _check_scheduler(address: str) -> None:
-    """Refuse an address that is not ``tcp://HOST:PORT``, and a server there that does not
-    greet like a Dask scheduler within DASK_TIMEOUT (Dask would take any 8 bytes it sends
-    for the length of a message, and allocate it)."""
-    parts = urllib.parse.urlsplit(address if "://" in address else f"tcp://{address}")
-    try:
-        port = parts.port
-    except ValueError:
-        port = None
-    if parts.scheme != "tcp" or not parts.hostname or port is None or parts.path not in ("", "/"):
-        raise InputError(f"--scheduler {address}: expected tcp://HOST:PORT (a scheduler with TLS needs its "
-                         "credentials, which analyze does not take)")
-    try:
-        with socket.create_connection((parts.hostname, port), timeout=DASK_TIMEOUT) as connection:
-            connection.settimeout(DASK_TIMEOUT)
-            greeting = b""
-            while len(greeting) < DASK_FRAME.size:
-                chunk = connection.recv(DASK_FRAME.size - len(greeting))
-                if not chunk:
-                    break
-                greeting += chunk
-    except TimeoutError:
-        raise InputError(f"--scheduler {address}: the server there does not greet like a Dask scheduler "
-                         f"(nothing within {DASK_TIMEOUT:g} s)") from None
-    except OSError as error:
-        raise InputError(f"cannot reach the Dask scheduler {address}: {error.strerror or error}") from None
-    if len(greeting) < DASK_FRAME.size or not 0 < DASK_FRAME.unpack(greeting)[0] <= DASK_GREETING_MAX:
-        raise InputError(f"--scheduler {address}: the server there is not a Dask scheduler")
-
-
 def analyse_file(path: Path, options: AnalysisOptions) -> Outcome:
     """The task run by a worker: the rows are formatted there too, in parallel."""
     result = analyse_path(path, options)
     return result, residue_lines(result) if isinstance(result, FileAnalysis) else ""
-
-
-def _end_with_parent(parent: int) -> None:
-    """In a worker (Linux): be killed when ``analyze`` (process ``parent``, which started it)
-    ends, so that killing ``analyze`` leaves no worker behind."""
-    if sys.platform.startswith("linux"):
-        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
-        if os.getppid() != parent:  # it ended while this worker started
-            os._exit(1)
-
-
-def _outcome(future, path: Path, failed: Callable[[Path, str], T]) -> T:
-    """A finished task's outcome; a worker that died gives ``failed``'s, not a failed run."""
-    try:
-        return future.result()
-    except Exception as error:  # noqa: BLE001 - e.g. a worker killed while reading this file
-        return failed(path, f"worker failed ({type(error).__name__}: {error})")
 
 
 def _failed_file(path: Path, reason: str) -> Outcome:
@@ -451,158 +272,7 @@ def plot_fig7(rows: list[SummaryRow], path: Path) -> None:
     figure.savefig(path, dpi=110, format="png")
 
 
-# --------------------------------------------------------------------------- compare
-
-
-def compare_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("file_a", type=Path, metavar="A", help="structure file (PDB or mmCIF, optionally gzipped)")
-    parser.add_argument("file_b", type=Path, nargs="?", metavar="B", help="second structure file (default: A)")
-    parser.add_argument("--chains", type=_chain_pair, metavar="X:Y",
-                        help="chain X of A and chain Y of B (default: the first two chains of A when B is not "
-                        "given, else the first chain of each)")
-    parser.add_argument("--core", metavar="RESIDUES",
-                        help="core set as residue numbers of chain X, e.g. 5-20,31,40A (default: the pairs within "
-                        "--core-cutoff after an iterative fit)")
-    parser.add_argument("--core-cutoff", type=bounded(float, 0.01, 50), default=1.0, metavar="Å",
-                        help="distance cutoff of the iterative core set (default %(default)g Å)")
-    parser.add_argument("--steps", type=bounded_list(1, 1000), default=(2, 4, 8, 16), metavar="M,...",
-                        help="fit on every M-th paired Cα from every offset (default 2,4,8,16)")
-    parser.add_argument("--depths", type=bounded_list(1, 16), default=(1, 2, 3, 4), metavar="K,...",
-                        help="fit on the residue points C^r of the curves at level J − K (default 1,2,3,4)")
-    parser.add_argument("--ribbon", choices=[k.value for k in RibbonKind], default=RibbonKind.PEPTIDE.value,
-                        help="curve of the C^r fits: peptide-plane ribbon (default) or the curve through the Cα")
-    parser.add_argument("--termini", choices=[t.value for t in Termini], default="atoms",
-                        help="terminal ribbon points: N and C atoms when present (default) or Cα extrapolations")
-    parser.add_argument("--pairing", choices=PAIRINGS, default="auto",
-                        help="pair residues by number, by sequence alignment or by structural alignment "
-                             "(auto: by number when it agrees, else by structure)")
-    parser.add_argument("--json", action="store_true", help="print a JSON object instead of the table")
-
-
-def run_compare(args: argparse.Namespace) -> int:
-    structure_a = load(args.file_a)
-    structure_b = load(args.file_b) if args.file_b is not None else structure_a
-    name_a, name_b = args.chains or _default_chains(structure_a, structure_b, args.file_b is None)
-    chain_a, chain_b = _chain(structure_a, name_a), _chain(structure_b, name_b)
-    core = None if args.core is None else _core_mask(chain_a, args.core)
-    try:
-        result = compare_chains(chain_a, chain_b, core_residues=core, cutoff=args.core_cutoff, steps=args.steps,
-                                depths=args.depths, ribbon=args.ribbon, termini=args.termini, pairing=args.pairing)
-    except ValueError as error:
-        raise InputError(str(error)) from None
-    report = comparison_report(result, f"{args.file_a} chain {name_a}",
-                               f"{args.file_b or args.file_a} chain {name_b}")
-    print(json.dumps(report, indent=2) if args.json else comparison_text(report))
-    return 0
-
-
-def comparison_report(result: Comparison, label_a: str, label_b: str) -> dict:
-    """The ``compare --json`` object (lengths in Å)."""
-    return {
-        "chain_a": label_a,
-        "chain_b": label_b,
-        "length_a": result.length_a,
-        "length_b": result.length_b,
-        "pairing": result.pairing,
-        "n_pairs": result.n_pairs,
-        "rms_all": round(result.rms_all, 4),
-        "tm_score": round(result.tm_score, 4),
-        "tm_score_length": result.length_a,
-        "tm_score_d0": round(result.d0, 4),
-        "tm_score_note": "superposition on all paired Cα; normalised by the length of the first chain",
-        "tm_score_a": round(result.match.tm_score_a, 4),
-        "tm_score_b": round(result.match.tm_score_b, 4),
-        "n_aligned": result.match.n_aligned,
-        "rms_aligned": round(result.match.rms_aligned, 4),
-        "identity": round(result.match.identity, 4),
-        "same_fold": result.match.same_fold,
-        "core_rule": result.core_rule,
-        "n_core": result.n_core,
-        "rms_core": round(result.rms_core, 4) if result.fits else None,
-        "fits": [
-            {"points": f.points, "depth": f.depth, "every": f.every, "start": f.start, "n_fit": f.n_fit,
-             "rms_core": round(f.rms_core, 4)}
-            for f in result.fits
-        ],
-    }
-
-
-def comparison_text(report: dict) -> str:
-    """The ``compare`` table."""
-    lines = [
-        f"{report['chain_a']} ({report['length_a']} residues) vs {report['chain_b']} ({report['length_b']} residues)",
-        f"{report['n_pairs']} residue pairs by {report['pairing']}",
-        f"fit on all paired Cα: rms {report['rms_all']:.3f} Å; TM-score {report['tm_score']:.4f} (of this "
-        f"superposition, normalised by the length of the first chain, {report['tm_score_length']} residues; "
-        f"d0 = {report['tm_score_d0']:.2f} Å)",
-        f"structural match: TM-score {report['tm_score_a']:.4f} (normalised by the first chain, "
-        f"{report['length_a']} residues), {report['tm_score_b']:.4f} (by the second, {report['length_b']}); "
-        f"{report['n_aligned']} aligned pairs, rms {report['rms_aligned']:.3f} Å, sequence identity "
-        f"{100 * report['identity']:.1f}%",
-        "same fold (TM-score >= 0.5)" if report["same_fold"] else "different folds (TM-score < 0.5)",
-    ]
-    if not report["fits"]:
-        return "\n".join(lines + [f"core set: {report['n_core']} pairs ({report['core_rule']}): too few for the "
-                                   "fits on fewer data (at least 3 are needed)"])
-    lines += [
-        f"core set: {report['n_core']} pairs ({report['core_rule']}); best fit on the core: rms {report['rms_core']:.3f} Å",
-        "",
-        "fits on fewer data, each judged by the rms over the core set (Å):",
-        f"{'fitted on':<20}{'every':>6}{'n fit':>7}{'min':>8}{'mean':>8}{'max':>8}   by start 1, 2, ...",
-    ]
-    groups: dict[tuple[str, int, int], list[dict]] = {}
-    for fit in report["fits"]:
-        groups.setdefault((fit["points"], fit["depth"], fit["every"]), []).append(fit)
-    for (points, depth, every), fits in groups.items():
-        rms = [f["rms_core"] for f in fits]
-        name = "Cα" if points == "CA" else f"C^r at level J − {depth}"
-        lines.append(f"{name:<20}{every:>6}{fits[0]['n_fit']:>7}{min(rms):8.3f}{np.mean(rms):8.3f}{max(rms):8.3f}   "
-                     + " ".join(f"{r:.3f}" for r in rms))
-    return "\n".join(lines)
-
-
-def _default_chains(a: Structure, b: Structure, same_file: bool) -> tuple[str, str]:
-    names_a = list(dict.fromkeys(s.chain for s in a.segments))
-    if not same_file:
-        return names_a[0], next(s.chain for s in b.segments)
-    if len(names_a) < 2:
-        raise InputError(f"{a.path}: has one protein chain ({names_a[0]}); give a second file or --chains X:Y")
-    return names_a[0], names_a[1]
-
-
-def _chain(structure: Structure, name: str) -> list[BackboneSegment]:
-    segments = [s for s in structure.segments if s.chain == name]
-    if not segments:
-        chains = ", ".join(dict.fromkeys(s.chain for s in structure.segments))
-        raise InputError(f"{structure.path}: no protein chain {name!r} (chains: {chains})")
-    return segments
-
-
-def _core_mask(chain: list[BackboneSegment], text: str) -> np.ndarray:
-    """Chain residues named by a list such as ``5-20,31,40A`` (ranges by residue number)."""
-    resseq = np.concatenate([s.resseq for s in chain])
-    labels = [f"{n}{i}" for s in chain for n, i in zip(s.resseq.tolist(), s.icode.tolist())]
-    mask = np.zeros(len(resseq), dtype=bool)
-    for item in text.split(","):
-        item = item.strip()
-        if match := re.fullmatch(r"(-?\d+)-(-?\d+)", item):
-            picked = (resseq >= int(match[1])) & (resseq <= int(match[2]))
-        else:
-            picked = np.array([label == item for label in labels], dtype=bool)
-        if not picked.any():
-            raise InputError(f"--core: no residue {item!r} in chain {chain[0].chain}")
-        mask |= picked
-    return mask
-
-
 # --------------------------------------------------------------------------- helpers
-
-
-def _chain_pair(text: str) -> tuple[str, str]:
-    parts = text.split(":")
-    if len(parts) != 2 or not all(parts):
-        raise argparse.ArgumentTypeError(f"expected two chain ids X:Y; got {text!r}")
-    return parts[0], parts[1]
 
 
 @functools.lru_cache(maxsize=None)

@@ -19,7 +19,7 @@ import numpy as np
 from tqdm import tqdm
 
 from app.arguments import bounded
-from app.cli.analysis import batch_arguments, run_tasks, structure_paths
+from app.cli.batch import batch_arguments, run_tasks, structure_paths
 from app.cli.structure import load
 from app.errors import InputError
 from core.analysis.database import SkippedFile

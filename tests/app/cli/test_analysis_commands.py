@@ -394,7 +394,7 @@ def test_the_local_cluster_is_private(tmp_path, capsys):
     import dask
     from dask.distributed import Client, LocalCluster
 
-    from app.cli.analysis import _local_client
+    from app.cli.batch import _local_client
 
     before = _listening_ports()
     with contextlib.ExitStack() as stack:
@@ -425,7 +425,7 @@ def test_a_server_that_is_not_a_scheduler_fails_within_the_timeout(reply, messag
     import threading
     import time
 
-    monkeypatch.setattr("app.cli.analysis.DASK_TIMEOUT", 1.0)
+    monkeypatch.setattr("app.cli.batch.DASK_TIMEOUT", 1.0)
     server = socket.create_server(("127.0.0.1", 0))
     held = []
 
