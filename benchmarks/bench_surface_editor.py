@@ -67,9 +67,9 @@ def _window(path: Path) -> MainWindow:
     from PySide6.QtTest import QTest
     from PySide6.QtWidgets import QDockWidget
 
-    from app.editor.docks.surfaces import KIND_NAMES
     from app.editor.document import Document
     from app.editor.main_window import MainWindow
+    from app.editor.surfaces.layer import KIND_NAMES
 
     document = Document()
     document.open(path)
@@ -118,7 +118,7 @@ def quit_while_building(path: Path) -> float:
     window.surface_panel.show_box.setChecked(True)
     _until(lambda: layer.stage.startswith("molecular surface"))
     start = time.perf_counter()
-    window.quit_action.trigger()
+    window.files.quit_action.trigger()
     return time.perf_counter() - start
 
 
@@ -131,7 +131,7 @@ def main() -> None:
     from PySide6.QtWidgets import QApplication
 
     QApplication.instance() or QApplication(sys.argv[:1])
-    from app.editor.surface_build import start_server
+    from app.editor.surfaces.build import start_server
 
     QSettings.setPath(QSettings.Format.NativeFormat, QSettings.Scope.UserScope, tempfile.mkdtemp())  # not the user's
     start_server()  # as the window does: it is ready when the command line's builds are timed

@@ -1,3 +1,6 @@
-"""The Qt editor: the document, undo commands, picking, naming what is under the pointer and
-dragging, the scripting API, the Help texts, image export, surfaces built in a process of
-their own, the main window and how it is launched."""
+"""The Qt editor. Here: the document and its undo commands, the validation and the map
+correlation that follow it, the main window (the composition root), its status bar and its
+one composition per event, the ``rw`` scripting API and the launch from the command line.
+Rooms: ``features`` (the window's features and their menus), ``interaction`` (the mouse in
+the view), ``scene`` (the 3D scene, one layer per representation), ``surfaces``, ``docks`` and
+``persistence`` (journals and sessions)."""

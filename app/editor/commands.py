@@ -3,21 +3,29 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from PySide6.QtGui import QUndoCommand
 
 from core.protein.model import Edit
 
-if TYPE_CHECKING:
-    from app.editor.document import Document
+
+class Edited(Protocol):
+    """What an undo command changes: the :class:`~app.editor.document.Document`, which carries
+    out an edit and undoes it exactly."""
+
+    def apply_edit(self, edit: Edit) -> None:
+        """Carry out ``edit``."""
+
+    def revert_edit(self, edit: Edit) -> None:
+        """Undo ``edit`` exactly."""
 
 
 class EditCommand(QUndoCommand):
     """One step: the edit of one segment (a whole drag), or of several at once (a level of a
     fit of a chain); redo applies them in turn, undo restores them exactly."""
 
-    def __init__(self, document: Document, edits: Edit | Sequence[Edit], text: str) -> None:
+    def __init__(self, document: Edited, edits: Edit | Sequence[Edit], text: str) -> None:
         super().__init__(text)
         self.document = document
         self.edits = (edits,) if isinstance(edits, Edit) else tuple(edits)

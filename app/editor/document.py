@@ -5,7 +5,8 @@ picked control point, the file names and the undo stack. Only its mutators chang
 state, and each emits a signal that says what changed, so views can subscribe and touch
 only what they must. Every edit reaches the model through an undo command
 (:class:`app.editor.commands.EditCommand`); a drag shows previews relative to the state at the
-start of the gesture and pushes one command when it ends.
+start of the gesture and pushes one command when it ends. Journals and sessions record the
+document and replay it (:mod:`app.editor.persistence.recording`) inside :meth:`Document.rebuilding`.
 
 A document holds one model of its file (:attr:`model_number`; another can be chosen while
 there are no edits to undo). A structure without a protein backbone (DNA) opens for
@@ -16,7 +17,8 @@ with :attr:`read_only_reason`, and ``levelChanged``, ``segmentChanged``, ``picke
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import NamedTuple
 
@@ -25,7 +27,6 @@ from PySide6.QtCore import QObject, QSignalBlocker, Signal
 from PySide6.QtGui import QUndoStack
 
 from app.editor.commands import EditCommand
-from app.editor.persistence import records
 from app.editor.scene.curves import LevelCurve, SegmentPath
 from core.geometry.regularize import FLANK, regularize_region, regularized
 from core.protein.model import Edit, EditableModel
@@ -85,7 +86,7 @@ class Document(QObject):
         self.source = b""
         """The file's bytes as read (journals and sessions embed them)."""
         self.replaying = False
-        """Whether :meth:`replay` is rebuilding the history (its steps are not new)."""
+        """Whether a recording is being replayed (:meth:`rebuilding`): its steps are not new."""
         self.save_path: Path | None = None
         """Where Save writes without asking; None until Save As chose a file."""
         self.segment = 0
@@ -348,64 +349,20 @@ class Document(QObject):
 
     # ------------------------------------------------------------------ recordings
 
-    def state(self) -> dict:
-        """The stack position, the clean position, the file names, level, segment and
-        multiresolution switch (the fields of an ``index`` record)."""
-        return {"index": self.undo_stack.index(), "clean": self.undo_stack.cleanIndex(),
-                "path": str(self.path), "save_path": None if self.save_path is None else str(self.save_path),
-                "level": self.level, "segment": self.segment, "multiresolution": self.multiresolution}
-
-    def recording(self) -> list[records.Record]:
-        """The document as records: the file as read, every undo step, the current state."""
-        stack = self.undo_stack
-        steps = [records.push(k, stack.text(k), stack.command(k).edits) for k in range(stack.count())]
-        return [records.header(self.path, self.kind.value, self.source, self.model_number), *steps,
-                records.Record("index", self.state())]
-
-    def replay(self, recording: list[records.Record]) -> None:
-        """Make the document what ``recording`` (:meth:`recording`, or a journal) describes:
-        the file as read (the same model), the same undo history at the same position, bit
-        for bit. Views are told once, at the end. Raises StructureError for an unreadable
-        embedded file."""
-        head, files, view = recording[0].fields, None, None
+    @contextmanager
+    def rebuilding(self) -> Iterator[None]:
+        """Rebuild the document from a recording (:func:`app.editor.persistence.recording.replay`):
+        inside, :attr:`replaying` is True and no signal comes, so the state may be set directly;
+        at the end views are told once that everything is new."""
         self.replaying = True
         try:
             with QSignalBlocker(self):
-                self.open(Path(head["path"]), head["kind"], records.source_of(recording[0]), records.model_of(head))
-                stack = self.undo_stack
-                for record in recording[1:]:
-                    if record.kind == "push":
-                        stack.setIndex(record.fields["at"])
-                        stack.push(EditCommand(self, records.edits_of(record), record.fields["text"]))
-                    elif record.kind == "index":
-                        stack.setIndex(record.fields["index"])
-                        files = view = record.fields
-                    elif record.kind == "state":
-                        view = record.fields
-                if files is not None:
-                    self._restore_files(files)
-                if view is not None:
-                    self.segment = max(0, min(int(view["segment"]), len(self._model.ribbons) - 1))
-                    self.multiresolution = bool(view["multiresolution"])
-                    self.level = float(np.clip(view["level"], 0.0, self.max_level))
+                yield
         finally:
             self.replaying = False
         for signal in (self.loaded, self.segmentChanged, self.levelChanged) if self.editable else (self.loaded,):
             signal.emit()
         self.fileChanged.emit()
-
-    def _restore_files(self, state: dict) -> None:
-        """The clean position and the file names of an ``index`` record."""
-        stack = self.undo_stack
-        index = stack.index()
-        if state["clean"] >= 0:
-            stack.setIndex(state["clean"])
-            stack.setClean()
-        else:
-            stack.resetClean()
-        stack.setIndex(index)
-        self.path = Path(state["path"])
-        self.save_path = None if state["save_path"] is None else Path(state["save_path"])
 
     # ------------------------------------------------------------------ internals
 

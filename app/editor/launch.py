@@ -142,7 +142,7 @@ def run_open(args: argparse.Namespace) -> int:
     # Qt and VTK load only for the window, so commands without one start fast.
     from PySide6.QtWidgets import QApplication
 
-    from app.editor.export_image import export_view
+    from app.editor.features.export import export_view
     from app.editor.main_window import MainWindow
 
     if sys.platform.startswith("linux"):
@@ -153,15 +153,15 @@ def run_open(args: argparse.Namespace) -> int:
         _check_output(path, args.overwrite)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     window = MainWindow()
-    window.unattended = script is not None or bool(images)
+    window.files.unattended = script is not None or bool(images)
     try:
         _load(window, args)
     except InputError:
         window.close()
         raise
     window.show()
-    if not window.unattended and not args.recover:
-        window.offer_recovery()
+    if not window.files.unattended and not args.recover:
+        window.sessions.offer_recovery()
     status = 0
     if script is not None:
         app.processEvents()  # the window laid out, as a person would first see it
@@ -170,7 +170,7 @@ def run_open(args: argparse.Namespace) -> int:
         app.processEvents()  # lay the window out before it is grabbed
         try:
             if args.screenshot is not None:
-                window.save_screenshot(args.screenshot, overwrite=args.overwrite)
+                window.export.save_screenshot(args.screenshot, overwrite=args.overwrite)
             if args.export_image is not None:
                 export_view(window.plotter, args.export_image, args.width, args.height,
                             supersample=args.supersample or 1, transparent=args.transparent, overwrite=args.overwrite)
@@ -180,7 +180,7 @@ def run_open(args: argparse.Namespace) -> int:
         except ValueError as error:  # a size the export refuses
             window.close()
             raise InputError(f"--export-image: {error}") from error
-    if window.unattended:
+    if window.files.unattended:
         window.close()
         kept = window.journal.kept
         if kept is not None:
@@ -203,12 +203,12 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
             raise InputError(f"nothing to recover: no journal of an editor that did not close cleanly in "
                              f"{window.journal.folder}")
         try:
-            print(f"{PROG}: {window.restore_journal(left[0])}", file=sys.stderr)
+            print(f"{PROG}: {window.sessions.restore_journal(left[0])}", file=sys.stderr)
         except (OSError, records.RecordError, StructureError) as error:
             raise InputError(f"{left[0]}: cannot restore ({error})") from error
     elif args.file.name.endswith(SESSION_SUFFIX):
         try:
-            window.open_session(args.file, raise_errors=True)
+            window.sessions.open_session(args.file, raise_errors=True)
         except SessionError as error:
             raise InputError(str(error)) from error
     else:
@@ -217,7 +217,7 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
         except StructureError as error:
             raise InputError(str(error)) from error
         if args.file != DEFAULT_STRUCTURE:
-            window.add_recent(args.file)
+            window.files.add_recent(args.file)
     if args.level is not None:
         try:
             window.document.set_level(args.level)

@@ -10,27 +10,47 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
-from app.editor.export_image import export_view
+from app.editor.features.export import export_view
 from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
 
 if TYPE_CHECKING:
     from app.editor.document import Document
-    from app.editor.main_window import MainWindow
+    from app.editor.features.files import Files
+    from app.editor.features.maps import MapsAndFits
+    from app.editor.features.navigation import Navigation
+    from app.editor.features.sessions import Sessions
+    from app.editor.map_correlation import LiveCorrelation
+    from app.editor.scene.view import View
+
+
+class Editor(Protocol):
+    """What ``rw`` drives: the editor window (:class:`~app.editor.main_window.MainWindow`)."""
+
+    document: Document
+    plotter: View
+    correlation: LiveCorrelation
+    files: Files
+    sessions: Sessions
+    navigation: Navigation
+    maps_and_fits: MapsAndFits
+
+    def quit_unattended(self, discard: bool = False) -> None:
+        """Close without asking; unsaved edits stay in the journal unless ``discard``."""
 
 
 class EditorAPI:
-    """The ``rw`` object: the document of ``window`` and what can be done with it."""
+    """The ``rw`` object: the document of ``editor`` and what can be done with it."""
 
-    def __init__(self, window: MainWindow) -> None:
-        self._window = window
+    def __init__(self, editor: Editor) -> None:
+        self._editor = editor
 
     @property
     def _document(self) -> Document:
-        document = self._window.document
+        document = self._editor.document
         if document.model is None:
             raise RuntimeError("no structure is open: rw.open(path) first")
         return document
@@ -92,7 +112,7 @@ class EditorAPI:
         the view on them, as Go to Residue (Ctrl+L) does; their chain becomes the edited
         segment. Returns their labels (ValueError for a residue that does not exist)."""
         document = self._document
-        return [document.row_label(int(row)) for row in self._window.go_to(residues)]
+        return [document.row_label(int(row)) for row in self._editor.navigation.go_to(residues)]
 
     def history(self) -> tuple[list[str], int]:
         """The names of the undo steps and the current position (steps done)."""
@@ -131,7 +151,7 @@ class EditorAPI:
         first is -1, the chain's smaller dynamic domain moved as a rigid body before level 0
         (:mod:`core.fitting.domains`)."""
         if resolution is not None:
-            self._window.correlation.set_resolution(float(resolution))
+            self._editor.correlation.set_resolution(float(resolution))
         return self._fit("map", levels)
 
     def fit_to_compared(self, levels: int | Sequence[int] | None = None) -> list[tuple[int, float]]:
@@ -144,14 +164,14 @@ class EditorAPI:
         self._editable
         chosen = None if levels is None else [int(levels)] if isinstance(levels, (int, np.integer)) else \
             [int(level) for level in levels]
-        fits = self._window.fit(target, True, chosen, raise_errors=True)
+        fits = self._editor.maps_and_fits.fit(target, True, chosen, raise_errors=True)
         return [(fit.level, fit.score) for fit in fits]
 
     @property
     def map_correlation(self) -> float | None:
         """The correlation of the edited segment with the open map (None without a map)."""
         self._document
-        correlation = self._window.correlation
+        correlation = self._editor.correlation
         correlation.update()
         if correlation.message:
             raise ValueError(correlation.message)
@@ -159,11 +179,11 @@ class EditorAPI:
 
     def undo(self) -> None:
         """Undo the last step (as Ctrl+Z)."""
-        self._window.undo_action.trigger()
+        self._editor.document.undo_stack.undo()
 
     def redo(self) -> None:
         """Redo the next step (as Ctrl+Shift+Z)."""
-        self._window.redo_action.trigger()
+        self._editor.document.undo_stack.redo()
 
     # ------------------------------------------------------------------ files
 
@@ -171,16 +191,16 @@ class EditorAPI:
         """Open a structure (PDB or mmCIF) or a session (``.rwsession``)."""
         path = Path(path)
         if path.name.endswith(SESSION_SUFFIX):
-            self._window.open_session(path, raise_errors=True)
+            self._editor.sessions.open_session(path, raise_errors=True)
         else:
-            self._window.open_file(path, raise_errors=True)
+            self._editor.files.open_file(path, raise_errors=True)
 
     def open_map(self, path: str | Path, columns: tuple[str, str] | None = None) -> None:
         """Show a density map (CCP4/MRC, optionally gzipped), or an MTZ file's maps (of
         ``columns``, amplitude and phase, else those refinement names 2mFo−DFc and mFo−DFc),
         as File ▸ Open Map… does (raises :class:`core.surfaces.volume.MapError` for a file
         that is not one)."""
-        self._window.open_map(Path(path), columns, raise_errors=True)
+        self._editor.maps_and_fits.open_map(Path(path), columns, raise_errors=True)
 
     def export(self, path: str | Path, *, overwrite: bool = False) -> Path:
         """Write the structure as edited (PDB or mmCIF by the extension) without making
@@ -193,7 +213,7 @@ class EditorAPI:
 
     def save_session(self, path: str | Path) -> Path:
         """Save the session (structure, undo history, view) to ``path`` (``.rwsession`` added if missing)."""
-        return self._window.write_session(Path(path))
+        return self._editor.sessions.write_session(Path(path))
 
     def screenshot(self, path: str | Path, width: int | None = None, height: int | None = None, *,
                    supersample: int = 1, transparent: bool = False, overwrite: bool = False) -> Path:
@@ -201,12 +221,12 @@ class EditorAPI:
         pixels (one given: the other by the view's aspect ratio; none: the view's size), rendered
         ``supersample`` (1, 2 or 4) times larger and averaged down, on a transparent background
         if ``transparent``."""
-        return export_view(self._window.plotter, Path(path), width, height, supersample=supersample,
+        return export_view(self._editor.plotter, Path(path), width, height, supersample=supersample,
                            transparent=transparent, overwrite=overwrite)
 
     def quit(self, discard: bool = False) -> None:
         """Close the editor. Unsaved edits stay in the recovery journal unless ``discard``."""
-        self._window.quit_unattended(discard)
+        self._editor.quit_unattended(discard)
 
 
 def _vector(delta: object) -> np.ndarray:

@@ -1,1 +1,2 @@
-"""What keeps the work: the record format, the crash-recovery journal and session files (no widgets)."""
+"""What keeps the work: the record format, a document recorded and replayed, the
+crash-recovery journal and session files (no widgets)."""

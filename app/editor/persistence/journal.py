@@ -23,7 +23,7 @@ import shiboken6
 from PySide6.QtCore import QObject, QTimer
 
 from app.editor.document import Document
-from app.editor.persistence import records
+from app.editor.persistence import recording, records
 
 SUFFIX = ".rwjournal"
 SYNC_DELAY_MS = 500
@@ -93,7 +93,7 @@ class Journal(QObject):
         stack = self.document.undo_stack
         if self.document.model is not None and stack.count():
             self._open_file()
-            self._write(*self.document.recording()[1:])
+            self._write(*recording.recording(self.document)[1:])
             self._mirror = [stack.command(k) for k in range(stack.count())]
 
     # ------------------------------------------------------------------ internals
@@ -119,7 +119,7 @@ class Journal(QObject):
             entries.append(records.push(count - 1, top.text(), top.edits))
             self._mirror[count - 1 :] = [top]
         del self._mirror[count:]
-        state = document.state()
+        state = recording.state(document)
         if entries or state != self._last:  # indexChanged and cleanChanged may both report one step
             self._state_timer.stop()
             self._write(*entries, records.Record("index", state))
@@ -131,7 +131,7 @@ class Journal(QObject):
 
     def _write_state(self) -> None:
         if self._fd is not None:
-            state = self.document.state()
+            state = recording.state(self.document)
             self._write(records.Record("state", {k: state[k] for k in ("level", "segment", "multiresolution")}))
 
     def _open_file(self) -> None:

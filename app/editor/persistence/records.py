@@ -1,4 +1,5 @@
-"""The record format of journals and session files, and the replay of a recording into a document.
+"""The record format of journals and session files (a document recorded and replayed:
+:mod:`app.editor.persistence.recording`).
 
 A file is :data:`MAGIC`, then records. A record is its payload length and CRC-32 (two
 little-endian uint32), then the payload: a line of JSON (``record``, the kind of record,

@@ -2,7 +2,7 @@
 
 A session holds the structure as read (embedded: it opens when the original file has
 moved), the whole undo history at its position, the level, segment and ribbon kind
-(:meth:`~app.editor.document.Document.recording`), and a ``view`` record: the display
+(:func:`~app.editor.persistence.recording.recording`), and a ``view`` record: the display
 layers and colouring, the camera and the compared structures (embedded too). It is the
 record format of journals (:mod:`app.editor.persistence.records`), written atomically.
 """

@@ -21,7 +21,7 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 from vtkmodules.vtkRenderingCore import vtkTextActor
 
 from app.editor.document import Change, Document, Pick
-from app.editor.drag import HANDLE_BOX, HANDLE_RADIUS
+from app.editor.interaction.drag import HANDLE_BOX, HANDLE_RADIUS
 from app.editor.scene import molecule, tube
 from app.editor.scene.molecule import Colouring
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from app.editor.document import Document
-from app.editor.drag import DragController, Mode, PointerEvent
+from app.editor.interaction.drag import DragController, Mode, PointerEvent
 from core.curves.splines import spline_space
 
 VIEW = np.array([0.0, 0.0, -1.0])  # the camera looks down -z

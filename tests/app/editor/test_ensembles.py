@@ -13,6 +13,8 @@ from test_window import _drag_control_point, _window
 from app.editor.document import Document
 from app.editor.main_window import MainWindow
 from app.editor.persistence import records, session
+from app.editor.persistence.recording import recording as recorded
+from app.editor.persistence.recording import replay
 from app.main import main
 from core.protein.reading import read_structure
 from core.protein.structure import StructureError
@@ -97,10 +99,10 @@ def test_a_recording_replays_the_same_model_and_older_ones_read_as_model_1(qapp:
     document.open(NMR, model=9)
     document.set_regularization(on_release=False)
     _move(document)
-    recording = document.recording()
+    recording = recorded(document)
     assert recording[0].fields["model"] == 9 and recording[0].fields["version"] == records.VERSION == 3
     again = Document()
-    again.replay(recording)
+    replay(again, recording)
     assert again.model_number == 9 and np.array_equal(again.model.coords, document.model.coords)
     again.undo_stack.undo()
     assert np.array_equal(again.model.coords, read_structure(NMR, model=9).coords)
@@ -109,11 +111,11 @@ def test_a_recording_replays_the_same_model_and_older_ones_read_as_model_1(qapp:
     first.open(NMR)
     first.set_regularization(on_release=False)
     _move(first)
-    old = first.recording()
+    old = recorded(first)
     fields = {k: v for k, v in old[0].fields.items() if k != "model"} | {"version": 1}  # as version 1 wrote it
     old[0] = records.Record("header", fields, old[0].arrays)
     decoded, _ = records.decode(records.MAGIC + b"".join(records.encode(r) for r in old))
-    again.replay(decoded)
+    replay(again, decoded)
     assert again.model_number == 1 and np.array_equal(again.model.coords, first.model.coords)
 
 
@@ -134,10 +136,10 @@ def test_the_model_spin_box_chooses_the_model_to_edit_and_save(qtbot: QtBot, tmp
     _drag_control_point(window, 2)
     assert window.document.undo_stack.count() == 1 and not spin.isEnabled()
     assert window.windowTitle() == "1L2Y.pdb.gz (model 6 of 38)[*] — ribbonwave" and window.isWindowModified()
-    assert window._write(tmp_path / "edited.pdb")
+    assert window.files.write(tmp_path / "edited.pdb")
     _assert_only_model_moved(tmp_path / "edited.pdb", NMR, 6, window.document.model.coords)
     assert window.windowTitle() == "edited.pdb (model 6 of 38)[*] — ribbonwave" and not window.isWindowModified()
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     assert spin.isEnabled()
 
 
@@ -153,10 +155,10 @@ def _edited_window(qtbot: QtBot, model: int) -> MainWindow:
 def test_a_session_restores_the_model(qtbot: QtBot, tmp_path: Path) -> None:
     window = _edited_window(qtbot, 4)
     history, coords = window.rw.history(), window.rw.coords()
-    saved = window.write_session(tmp_path / "ensemble")
+    saved = window.sessions.write_session(tmp_path / "ensemble")
     assert session.read(saved)[0][0].fields["model"] == 4
     window.document.undo_stack.setClean()  # no question on the way out
-    assert window.open_file(DATA / "1UBQ.pdb.gz") and window.open_session(saved)
+    assert window.files.open_file(DATA / "1UBQ.pdb.gz") and window.sessions.open_session(saved)
     assert window.rw.model == 4 and window.dimension_panel.model_number.value() == 4
     assert window.windowTitle().startswith("1L2Y.pdb.gz (model 4 of 38)")
     assert window.rw.history() == history and np.array_equal(window.rw.coords(), coords)
@@ -170,10 +172,10 @@ def test_crash_recovery_restores_the_model(qtbot: QtBot) -> None:
     crashed = _edited_window(qtbot, 17)
     history, coords, path = crashed.rw.history(), crashed.rw.coords(), crashed.journal.path
     assert records.read(path)[0][0].fields["model"] == 17
-    crashed.unattended = True
+    crashed.files.unattended = True
     crashed.close()  # as a crash leaves it: the journal stays
     window = _window(qtbot, DATA / "3PTB.pdb.gz")
-    window.restore_journal(path)
+    window.sessions.restore_journal(path)
     assert window.rw.model == 17 and window.windowTitle().startswith("1L2Y.pdb.gz (model 17 of 38)")
     assert window.rw.history() == history and np.array_equal(window.rw.coords(), coords)
 

@@ -11,7 +11,7 @@ from PySide6.QtGui import QImage
 from PySide6.QtWidgets import QDialogButtonBox, QFileDialog, QMessageBox
 from pytestqt.qtbot import QtBot
 
-from app.editor.export_image import ExportImageDialog, export_view, render_view
+from app.editor.features.export import ExportImageDialog, export_view, render_view
 from app.editor.main_window import MainWindow
 from app.editor.scene.scene import Layer
 from app.main import main
@@ -117,8 +117,8 @@ def test_supersampling_averages_n_by_n_samples_a_pixel(window: MainWindow) -> No
 def test_the_dialog_writes_what_its_fields_say(window: MainWindow, qtbot: QtBot, tmp_path: Path,
                                                monkeypatch: pytest.MonkeyPatch) -> None:
     file_menu = window.menuBar().actions()[0].menu()
-    assert window.export_action in file_menu.actions() and window.export_action.shortcut().toString() == "Ctrl+E"
-    window.export_action.trigger()
+    assert window.export.export_action in file_menu.actions() and window.export.export_action.shortcut().toString() == "Ctrl+E"
+    window.export.export_action.trigger()
     dialog = window.findChild(ExportImageDialog)
     assert dialog.isVisible() and [dialog.width_box.value(), dialog.height_box.value()] == window.plotter.window_size
     assert dialog.path().name == "1UBQ.png" and dialog.supersampling.currentData() == 2
@@ -153,7 +153,7 @@ def test_the_dialog_writes_what_its_fields_say(window: MainWindow, qtbot: QtBot,
 
 def test_the_dialog_asks_before_it_replaces_a_file_and_says_why_it_cannot_write(
         window: MainWindow, qtbot: QtBot, tmp_path: Path, questions, errors: list[str]) -> None:
-    dialog = window.export_image_dialog()
+    dialog = window.export.export_image_dialog()
     missing = tmp_path / "no-such-folder" / "view.png"
     dialog.file.setText(str(missing))
     qtbot.mouseClick(_save_button(dialog), Qt.MouseButton.LeftButton)

@@ -91,7 +91,7 @@ def test_every_step_is_appended_as_a_delta(qtbot: QtBot, state_home: Path) -> No
                                         edit.new_coords))
         assert arrays < sizes[-1] - sizes[-2] < arrays + 1024  # the edit's deltas and a line of JSON
         assert sizes[-1] - sizes[-2] < window.document.model.coords.nbytes / 10  # not the model
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     kinds = [r.kind for r in _journal_records(window)]
     assert kinds == ["header", "push", "index", "push", "index", "push", "index", "push", "index", "index"]
     assert _journal_records(window)[-1].fields["index"] == 3
@@ -126,7 +126,7 @@ def test_a_saved_document_closes_without_its_journal(qtbot: QtBot, tmp_path: Pat
 def test_an_unattended_close_keeps_unsaved_edits(qtbot: QtBot, questions) -> None:
     window = _window(qtbot, DATA / "1UBQ.pdb.gz")
     _edit(window, 3)
-    window.unattended = True
+    window.files.unattended = True
     path = window.journal.path
     window.close()
     assert path.exists() and not questions.asked
@@ -137,18 +137,18 @@ def test_the_next_start_offers_to_restore(qtbot: QtBot, questions) -> None:
     crashed = _window(qtbot, DATA / "1UBQ.pdb.gz")
     for k in range(4):
         _edit(crashed, k + 2)
-    crashed.undo_action.trigger()
+    crashed.editing.undo_action.trigger()
     coords, history = crashed.document.model.coords.copy(), crashed.rw.history()
-    crashed.unattended = True
+    crashed.files.unattended = True
     crashed.close()  # as a crash leaves it: the journal stays
     window = _window(qtbot, DATA / "3PTB.pdb.gz")
     questions.answer = QMessageBox.StandardButton.Yes
-    window.offer_recovery()
+    window.sessions.offer_recovery()
     assert "did not close cleanly" in questions.asked[-1]
     assert window.rw.history() == history and np.array_equal(window.document.model.coords, coords)
     assert window.document.modified and window.document.path.name == "1UBQ.pdb.gz"
-    window.redo_action.trigger()
-    window.undo_action.trigger()
+    window.editing.redo_action.trigger()
+    window.editing.undo_action.trigger()
     assert np.array_equal(window.document.model.coords, coords)
     assert journal.orphans(window.journal.folder) == []  # the restored history is journalled anew, held
     questions.answer = QMessageBox.StandardButton.Discard  # for the windows' close after the test
@@ -161,16 +161,16 @@ def test_a_damaged_journal_restores_the_steps_before_the_damage(qtbot: QtBot) ->
         _edit(crashed, k + 2)
         states.append(crashed.document.model.coords.copy())
     path = crashed.journal.path
-    crashed.unattended = True
+    crashed.files.unattended = True
     crashed.close()
     data = path.read_bytes()
     path.write_bytes(data[:-30])  # the last record cut off mid-write
     window = _window(qtbot, DATA / "3PTB.pdb.gz")
-    message = window.restore_journal(path)
+    message = window.sessions.restore_journal(path)
     assert "cut off" in message and window.rw.history()[1] == 3
     assert np.array_equal(window.document.model.coords, states[2])  # the cut-off record was the last index only
     path.write_bytes(data[: len(data) // 2])
-    window.restore_journal(path)
+    window.sessions.restore_journal(path)
     count = window.document.undo_stack.count()
     assert 0 < count < 3 and np.array_equal(window.document.model.coords, states[count - 1])
 

@@ -54,6 +54,6 @@ def test_5000_slider_and_drag_steps_with_undo(qtbot: QtBot) -> None:
         document.set_regularization(on_release=drag % 25 == 0)  # some releases regularize, as by default
         interactor.InvokeEvent("LeftButtonReleaseEvent")
         assert document.undo_stack.count() == 1 and not np.array_equal(document.model.coords, original)
-        window.undo_action.trigger()
+        window.editing.undo_action.trigger()
         assert np.array_equal(document.model.coords, original)
     assert steps == 5000

@@ -96,7 +96,7 @@ def test_columns_refinement_does_not_name_are_chosen(open_window: Callable[[str]
         return items[0], True
 
     monkeypatch.setattr(QInputDialog, "getItem", choose)
-    assert window.open_map(path)  # as File ▸ Open Map… does
+    assert window.maps_and_fits.open_map(path)  # as File ▸ Open Map… does
     assert asked == [["FCALC, PHCALC", "FDIFF, PHDIFF"]]
     assert window.maps.columns == (("FCALC", "PHCALC"), None)
     assert len(MISSING) == 6
@@ -116,7 +116,7 @@ def test_the_whole_of_a_box_is_contoured_once(open_window: Callable[[str], MainW
     contoured = []
     maps.contoured.connect(lambda: contoured.append(1))
     frames = window.plotter.frames
-    window.go_to("40")  # the view's centre moves
+    window.navigation.go_to("40")  # the view's centre moves
     qtbot.waitUntil(lambda: window.plotter.frames > frames)
     qtbot.wait(3 * RECONTOUR_MS)
     assert not contoured

@@ -90,7 +90,7 @@ def test_the_map_is_a_mesh_around_the_centre_that_follows_it(window: MainWindow,
     assert np.linalg.norm(maps.mesh.points - maps.centre, axis=1).max() <= maps.radius
     assert "4AKE_8A.ccp4" in window.map_panel.file_text.text()
     before, frames = maps.mesh.points.copy(), window.plotter.frames
-    window.go_to("150")  # centres the view on a residue at the edge of the chain
+    window.navigation.go_to("150")  # centres the view on a residue at the edge of the chain
     qtbot.waitUntil(lambda: np.array_equal(maps.centre, _focal_point(window)))
     assert not np.array_equal(maps.mesh.points[:10], before[:10])
     assert np.linalg.norm(maps.mesh.points - maps.centre, axis=1).max() <= maps.radius
@@ -130,9 +130,9 @@ def test_a_broken_map_file_gives_a_dialog(
     junk = tmp_path / "broken.map"
     junk.write_bytes(b"not a map" * 200)
     monkeypatch.setattr(QFileDialog, "getOpenFileName", lambda *args: (str(junk), ""))
-    window.open_map_action.trigger()  # File ▸ Open Map…
+    window.maps_and_fits.open_map_action.trigger()  # File ▸ Open Map…
     assert len(errors) == 1 and "not a CCP4/MRC map" in errors[0]
-    assert window.maps.density is None and not window.fit_actions[0].isEnabled()
+    assert window.maps.density is None and not window.maps_and_fits.fit_actions[0].isEnabled()
 
 
 def test_the_correlation_shows_and_follows_edits_ten_times_a_second(window: MainWindow, qtbot: QtBot) -> None:
@@ -140,7 +140,7 @@ def test_the_correlation_shows_and_follows_edits_ten_times_a_second(window: Main
     qtbot.waitUntil(lambda: correlation.value is not None)
     assert 0.3 < correlation.value < 0.95
     assert f"{correlation.value:.3f}" in window.map_panel.cc_text.text()
-    assert window.status_labels["map"].text() == f"map CC {correlation.value:.3f}"
+    assert window.status.labels["map"].text() == f"map CC {correlation.value:.3f}"
     qtbot.wait(INTERVAL_MS + 20)
     before, first = correlation.updates, correlation.value
     document.pick_point(5)
@@ -169,7 +169,7 @@ def test_fit_to_map_at_this_level_is_one_undo_step(window: MainWindow) -> None:
     document = window.document
     document.set_level(2)
     cc = window.rw.map_correlation
-    window.fit_actions[0].trigger()  # Edit ▸ Fit to Map at This Level
+    window.maps_and_fits.fit_actions[0].trigger()  # Edit ▸ Fit to Map at This Level
     assert document.undo_stack.count() == 1
     assert document.undo_stack.text(0).startswith("Fit to map at level 2 (CC ")
     assert window.rw.map_correlation > cc + 0.05
@@ -216,7 +216,7 @@ def test_a_fit_moves_every_segment_of_the_edited_chain_in_one_step_a_level(
                                  + shift, RESOLUTION))
     window.map_panel.resolution.setValue(RESOLUTION)
     document.set_level(1)
-    window.fit_actions[0].trigger()  # Edit ▸ Fit to Map at This Level
+    window.maps_and_fits.fit_actions[0].trigger()  # Edit ▸ Fit to Map at This Level
     assert window.rw.history()[1] == 1  # one step
     ca = ca_rows(structure)
     for segment in structure.segments:
@@ -238,7 +238,7 @@ def test_cancel_during_the_levels_undoes_the_whole_fit(window: MainWindow, qtbot
             dialog.cancel()  # Cancel pressed once level 0 is done
 
     document.undo_stack.indexChanged.connect(cancel)
-    window.fit_actions[1].trigger()  # Edit ▸ Fit to Map Coarse to Fine
+    window.maps_and_fits.fit_actions[1].trigger()  # Edit ▸ Fit to Map Coarse to Fine
     document.undo_stack.indexChanged.disconnect(cancel)
     assert window.rw.history()[1] == 0
     assert np.array_equal(document.model.coords, document.structure.coords)
@@ -258,7 +258,7 @@ def test_cancel_during_the_refinement_keeps_a_regularized_model(window: MainWind
             QTimer.singleShot(400, dialog.cancel)  # in the middle of the refinement
 
     document.undo_stack.indexChanged.connect(regularized)
-    window.fit_actions[1].trigger()
+    window.maps_and_fits.fit_actions[1].trigger()
     document.undo_stack.indexChanged.disconnect(regularized)
     assert seen and seen[0][0] and seen[0][1] < seen[0][2]  # the dialog still up, the refinement to come
     steps, index = window.rw.history()
@@ -269,12 +269,12 @@ def test_cancel_during_the_refinement_keeps_a_regularized_model(window: MainWind
 
 def test_fit_to_compared_structure_brings_the_ca_rmsd_down(open_window: Callable[[str], MainWindow]) -> None:
     window = open_window(CLOSED)
-    assert not window.fit_actions[3].isEnabled()
+    assert not window.maps_and_fits.fit_actions[3].isEnabled()
     window.comparison.add(DATA / OPEN)
     target = read_structure(DATA / OPEN)
     target_ca = target.coords[ca_rows(target)]
     rmsd = _ca_rmsd(window, target_ca)
-    window.fit_actions[2].trigger()  # at this level (6)
+    window.maps_and_fits.fit_actions[2].trigger()  # at this level (6)
     assert window.rw.history() == ([window.document.undo_stack.text(0)], 1)
     assert window.document.undo_stack.text(0).startswith("Fit to 4AKE_adk_open at level 6 (Cα rmsd ")
     assert _ca_rmsd(window, target_ca) < rmsd / 2
@@ -310,6 +310,6 @@ def test_fits_need_a_target(open_window: Callable[[str], MainWindow], errors: li
     with pytest.raises(ValueError, match="no compared structure"):
         window.rw.fit_to_compared()
     window.comparison.add(DATA / "1UBQ.pdb.gz")  # another protein
-    window.fit("compared", False)
+    window.maps_and_fits.fit("compared", False)
     assert len(errors) == 1 and "another fold" in errors[0]
     assert window.document.undo_stack.count() == 0

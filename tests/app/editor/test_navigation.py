@@ -11,7 +11,7 @@ from PySide6.QtCore import QPoint, Qt
 from PySide6.QtWidgets import QToolTip
 from pytestqt.qtbot import QtBot
 
-from app.editor.drag import HANDLE_BOX, HANDLE_RADIUS
+from app.editor.interaction.drag import HANDLE_BOX, HANDLE_RADIUS
 from app.editor.main_window import MainWindow
 from app.editor.scene.scene import MIN_POINT_PIXELS, TUBE_SIDES, Layer, Others
 
@@ -76,7 +76,7 @@ def test_hovering_names_the_residue_the_point_and_the_atom(window: MainWindow, q
     qtbot.mouseMove(window.plotter, _widget_point(window, _ca(window, row)))  # a real Qt move
     segment = document.structure.segments[0]
     expected = f"{segment.labels[row]} · {'helix sheet other'.split()['HEC'.index(segment.ss[row])]}"
-    assert window.status_labels["hover"].text() == expected
+    assert window.status.labels["hover"].text() == expected
     qtbot.waitUntil(lambda: QToolTip.text() == expected)
 
     window.scene.set_layer(Layer.CONTROL_POINTS, True)
@@ -84,7 +84,7 @@ def test_hovering_names_the_residue_the_point_and_the_atom(window: MainWindow, q
     index = int(window.scene.shown_control_points()[4])
     _move(window, _display(window, curve.control_points[index]))
     residues = document.point_residues(index)
-    assert window.status_labels["hover"].text() == (
+    assert window.status.labels["hover"].text() == (
         f"control point {index} at level {document.shown_level():.2f}: moves "
         f"{document.residue_range(residues)} ({len(residues)} residues)")
 
@@ -96,10 +96,10 @@ def test_hovering_names_the_residue_the_point_and_the_atom(window: MainWindow, q
     window.plotter.camera.zoom(4.0)
     window.plotter.render()
     _move(window, _display(window, document.model.coords[nz]))
-    assert window.status_labels["hover"].text().split(" · ")[0] == f"{document.row_label(table.residue[nz])} NZ"
+    assert window.status.labels["hover"].text().split(" · ")[0] == f"{document.row_label(table.residue[nz])} NZ"
 
     _move(window, (2, 2))  # the corner: nothing
-    assert window.status_labels["hover"].text() == ""
+    assert window.status.labels["hover"].text() == ""
 
 
 # ------------------------------------------------------------------ go to residue, centring, selection
@@ -109,22 +109,22 @@ def test_go_to_residue_by_keyboard(window: MainWindow, qtbot: QtBot) -> None:
     window.activateWindow()
     qtbot.waitUntil(window.isActiveWindow)
     qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
-    assert window.go_to_field.hasFocus()
-    qtbot.keyClicks(window.go_to_field, "A:45")
-    qtbot.keyClick(window.go_to_field, Qt.Key.Key_Return)
+    assert window.navigation.go_to_field.hasFocus()
+    qtbot.keyClicks(window.navigation.go_to_field, "A:45")
+    qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
     assert list(window.document.selection) == [44]
     np.testing.assert_allclose(_focal(window), _ca(window, 44), atol=1e-6)
-    assert window.status_labels["pick"].text().startswith("selected A:PHE45 (1 residues)")
+    assert window.status.labels["pick"].text().startswith("selected A:PHE45 (1 residues)")
     qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
-    qtbot.keyClicks(window.go_to_field, "30-35")  # the field's text was selected: typing replaces it
-    qtbot.keyClick(window.go_to_field, Qt.Key.Key_Return)
+    qtbot.keyClicks(window.navigation.go_to_field, "30-35")  # the field's text was selected: typing replaces it
+    qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
     assert list(window.document.selection) == list(range(29, 35))
     np.testing.assert_allclose(_focal(window), np.mean([_ca(window, r) for r in range(29, 35)], axis=0), atol=1e-6)
 
     before = _focal(window)
     qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
-    qtbot.keyClicks(window.go_to_field, "A:999")
-    qtbot.keyClick(window.go_to_field, Qt.Key.Key_Return)
+    qtbot.keyClicks(window.navigation.go_to_field, "A:999")
+    qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
     assert window.statusBar().currentMessage() == "no residue A:999 in chain A"
     assert list(window.document.selection) == list(range(29, 35)) and np.array_equal(_focal(window), before)
     qtbot.keyClick(window.plotter, Qt.Key.Key_Escape)
@@ -133,7 +133,7 @@ def test_go_to_residue_by_keyboard(window: MainWindow, qtbot: QtBot) -> None:
 
 def test_go_to_another_chain_makes_it_the_edited_segment(open_window: Opener) -> None:
     window = open_window("4HHB.pdb.gz")
-    rows = window.go_to("C:87")
+    rows = window.navigation.go_to("C:87")
     document = window.document
     assert document.structure.segments[document.segment].chain == "C"
     assert document.row_label(int(rows[0])) == "C:HIS87"

@@ -61,7 +61,7 @@ def test_each_event_draws_one_frame(qtbot: QtBot, view_kind: str, open_window: O
     assert _frames_of(qtbot, window, lambda: qtbot.mouseRelease(view, Qt.MouseButton.LeftButton,
                                                                 pos=at + QPoint(30, 20))) == 1
     assert document.undo_stack.count() == 1
-    assert _frames_of(qtbot, window, window.undo_action.trigger) == 1
+    assert _frames_of(qtbot, window, window.editing.undo_action.trigger) == 1
 
     centre = QPointF(view.width() / 2, view.height() / 2)
     wheel = QWheelEvent(centre, view.mapToGlobal(centre), QPoint(), QPoint(0, 120), Qt.MouseButton.NoButton,
@@ -141,12 +141,12 @@ def test_help_names_the_keys_bound_and_the_versions(qtbot: QtBot) -> None:
     window = MainWindow()
     qtbot.addWidget(window)
     window.show()
-    reference = window.show_reference()
+    reference = window.help.show_reference()
     assert reference.isVisible()
     assert "Go to Residue" in reference.text() and "Ctrl+L" in reference.text() and "Ctrl+Y" in reference.text()
     assert "Double click" in reference.text()
     reference.close()
-    about = window.show_about()
+    about = window.help.show_about()
     for part in (f"Qt {qVersion()}", f"VTK {vtk.vtkVersion.GetVTKVersion()}", f"gemmi {gemmi.__version__}"):
         assert part in about.text()
     about.close()

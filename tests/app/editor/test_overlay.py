@@ -153,7 +153,7 @@ def test_new_structure_refits_and_bad_files_are_reported(window: MainWindow, tmp
     bad.write_text("not a structure\n")
     problems = window.comparison_panel.add_files([bad, tmp_path / "missing.pdb"])
     assert len(problems) == 2 and problems[0].startswith("bad.pdb: ") and len(window.comparison.items) == 2
-    window.open_file(DATA / "1TIM.pdb.gz")  # another protein: the proteases are refitted onto its chain A
+    window.files.open_file(DATA / "1TIM.pdb.gz")  # another protein: the proteases are refitted onto its chain A
     assert [i.fitted_to for i in window.comparison.items] == ["A", "A"]
     for row, item in enumerate(window.comparison.items):
         assert window.comparison_view.actor_name(item) in window.plotter.actors

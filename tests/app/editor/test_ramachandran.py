@@ -293,7 +293,7 @@ def test_the_dock_in_the_window_follows_a_drag_once_raised(qtbot: QtBot) -> None
     assert moved and _rows_at(panel, _offsets(panel.moved_rings)) == moved & set(panel.points.rows.tolist())
     validation.raise_()
     qtbot.waitUntil(lambda: not panel.on_screen())
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     qtbot.wait(2 * REDRAW_INTERVAL_MS)
     assert panel.redraws == 1 and len(_offsets(panel.moved_rings)) > 0  # off screen: not redrawn
     dock.raise_()

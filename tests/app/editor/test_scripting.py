@@ -146,8 +146,8 @@ def test_go_to_is_what_the_go_to_field_does(qtbot: QtBot) -> None:
     assert rw.go_to("B:40-42") == rw.selection == ["B:ARG40", "B:PHE41", "B:PHE42"]
     assert window.document.structure.segments[rw.segment].chain == "B"
     typed = _window(qtbot, DATA / "4HHB.pdb.gz")
-    typed.go_to_field.setText("B:40-42")
-    typed.go_to_field.returnPressed.emit()  # as Enter in the field
+    typed.navigation.go_to_field.setText("B:40-42")
+    typed.navigation.go_to_field.returnPressed.emit()  # as Enter in the field
     assert typed.rw.selection == rw.selection and typed.rw.segment == rw.segment
     assert np.allclose(typed.plotter.camera.focal_point, window.plotter.camera.focal_point)
     with pytest.raises(ValueError, match="no residue B:400"):

@@ -47,11 +47,11 @@ def test_a_session_round_trips_bit_for_bit(qtbot: QtBot, tmp_path: Path, path: P
     rw.move(n - 1, [0.5, 0.5, 0.5])
     rw.undo()
     history, states, level = rw.history(), _states(window), rw.level
-    saved = window.write_session(tmp_path / "work")
+    saved = window.sessions.write_session(tmp_path / "work")
     assert saved.name == "work.rwsession"
     window.document.undo_stack.setClean()  # no question on the way out
-    assert window.open_file(DATA / "3PTB.pdb.gz")
-    assert window.open_session(saved)
+    assert window.files.open_file(DATA / "3PTB.pdb.gz")
+    assert window.sessions.open_session(saved)
     assert rw.history() == history and rw.level == level and window.document.modified
     assert window.document.kind is kind
     assert all(np.array_equal(a, b) for a, b in zip(_states(window), states, strict=True))
@@ -73,10 +73,10 @@ def test_the_view_and_compared_structures_come_back(qtbot: QtBot, tmp_path: Path
     window.plotter.camera.azimuth = 40
     camera = np.array([tuple(v) for v in window.plotter.camera_position])
     layers = set(window.scene.layers)
-    saved = window.write_session(tmp_path / "view.rwsession")
+    saved = window.sessions.write_session(tmp_path / "view.rwsession")
     compared.unlink()  # the session embeds the compared structure too
     other = _window(qtbot, DATA / "1UBQ.pdb.gz")
-    assert other.open_session(saved)
+    assert other.sessions.open_session(saved)
     assert other.scene.layers == layers and other.scene.colouring is Colouring.CHAIN and other.scene.fat_helices
     assert np.allclose([tuple(v) for v in other.plotter.camera_position], camera)
     assert [(item.structure.entry_id, item.visible) for item in other.comparison.items] == [("1BMA", False)]
@@ -90,10 +90,10 @@ def test_a_session_opens_when_the_structure_file_has_moved(qtbot: QtBot, tmp_pat
     window = _window(qtbot, original)
     window.rw.move(5, [3.0, 0.0, 0.0])
     coords = window.rw.coords()
-    saved = window.write_session(tmp_path / "s.rwsession")
+    saved = window.sessions.write_session(tmp_path / "s.rwsession")
     original.unlink()
     window.document.undo_stack.setClean()
-    assert window.open_session(saved)
+    assert window.sessions.open_session(saved)
     assert np.array_equal(window.rw.coords(), coords) and window.document.path == original
 
 
@@ -101,7 +101,7 @@ def test_bad_sessions_give_a_message(qtbot: QtBot, tmp_path: Path, errors: list[
                                      capsys: pytest.CaptureFixture[str]) -> None:
     window = _window(qtbot, DATA / "1UBQ.pdb.gz")
     window.rw.move(5, [3.0, 0.0, 0.0])
-    saved = window.write_session(tmp_path / "s.rwsession")
+    saved = window.sessions.write_session(tmp_path / "s.rwsession")
     data = saved.read_bytes()
     newer = records.Record("header", {"version": records.VERSION + 1, "path": "x.pdb", "kind": "peptide"})
     cases = {
@@ -112,7 +112,7 @@ def test_bad_sessions_give_a_message(qtbot: QtBot, tmp_path: Path, errors: list[
     for name, (content, message) in cases.items():
         (tmp_path / name).write_bytes(content)
         window.document.undo_stack.setClean()
-        assert not window.open_session(tmp_path / name)
+        assert not window.sessions.open_session(tmp_path / name)
         assert message in errors[-1] and name in errors[-1]
         assert main([str(tmp_path / name), "--screenshot", str(tmp_path / "x.png")]) == 1
         err = capsys.readouterr().err
@@ -121,7 +121,7 @@ def test_bad_sessions_give_a_message(qtbot: QtBot, tmp_path: Path, errors: list[
 
 def test_saving_a_session_is_atomic(qtbot: QtBot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     window = _window(qtbot, DATA / "1UBQ.pdb.gz")
-    saved = window.write_session(tmp_path / "s.rwsession")
+    saved = window.sessions.write_session(tmp_path / "s.rwsession")
     before = saved.read_bytes()
     window.rw.move(5, [3.0, 0.0, 0.0])
 
@@ -130,7 +130,7 @@ def test_saving_a_session_is_atomic(qtbot: QtBot, tmp_path: Path, monkeypatch: p
 
     monkeypatch.setattr("core.protein.writing.os.replace", full_disk)
     with pytest.raises(OSError):
-        window.write_session(saved)
+        window.sessions.write_session(saved)
     assert saved.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["s.rwsession"]
 
 
@@ -140,8 +140,8 @@ def test_the_file_menu_saves_and_opens_sessions(qtbot: QtBot, tmp_path: Path, mo
     coords = window.rw.coords()
     target = tmp_path / "menu"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(target), ""))
-    window.save_session_action.trigger()
+    window.sessions.save_session_action.trigger()
     monkeypatch.setattr(QFileDialog, "getOpenFileName", lambda *a, **k: (str(target) + ".rwsession", ""))
     window.rw.undo()
-    window.open_session_action.trigger()  # the conftest answers 'Discard' to the unsaved edits
+    window.sessions.open_session_action.trigger()  # the conftest answers 'Discard' to the unsaved edits
     assert np.array_equal(window.rw.coords(), coords) and window.rw.history()[1] == 1

@@ -14,7 +14,7 @@ ROOT = Path(__file__).resolve().parents[3]
 DEFERRED = (
     "skimage", "pywt", "dask", "distributed", "scipy.ndimage", "core.surfaces.levelled", "core.surfaces.molecular",
     "core.surfaces.volume", "core.surfaces.globe", "core.analysis.compare", "core.analysis.fold_alignment",
-    "core.analysis.tm_align", "numba", "core.fitting", "app.editor.fitting", "matplotlib.backends.backend_qtagg", "app.cli",
+    "core.analysis.tm_align", "numba", "core.fitting", "app.editor.features.fitting", "matplotlib.backends.backend_qtagg", "app.cli",
     "pyvistaqt", "qtpy", "app.editor.scene.widget_view",
 )  # fmt: skip
 """Modules (and their submodules) that the first window does without."""

@@ -14,10 +14,11 @@ import pyvista as pv
 from pytestqt.qtbot import QtBot
 
 from app.editor.commands import EditCommand
-from app.editor.docks.surfaces import COLOURING_NAMES, KIND_NAMES, STEPS_PER_LEVEL, SurfacePanel
+from app.editor.docks.surfaces import COLOURING_NAMES, STEPS_PER_LEVEL, SurfacePanel
 from app.editor.document import Document
 from app.editor.main_window import MainWindow
 from app.editor.scene.scene import Layer
+from app.editor.surfaces.layer import KIND_NAMES
 from core.surfaces.levelled import KINDS
 from core.surfaces.molecular import COLOURINGS
 
@@ -117,7 +118,7 @@ def test_globe_levels_colourings_and_screenshot(qtbot: QtBot, ubiquitin: Documen
     panel.opacity.setValue(60)
     panel.parentWidget().raise_()  # the dock's tab
     shot = tmp_path / "surface.png"
-    window.save_screenshot(shot)
+    window.export.save_screenshot(shot)
     assert shot.stat().st_size > 50_000
 
     panel.show_box.setChecked(False)
@@ -181,7 +182,7 @@ def test_failures_are_reported_and_a_new_file_drops_the_cache(qtbot: QtBot, ubiq
 
     panel.kind.setCurrentIndex(list(KIND_NAMES).index("globe"))
     qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
-    window.open_file(DATA / "1L2Y.pdb.gz")  # Trp-cage, 20 residues
+    window.files.open_file(DATA / "1L2Y.pdb.gz")  # Trp-cage, 20 residues
     qtbot.waitUntil(lambda: panel.layer.built is not None and not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
     vertices = _actor_mesh(window).points
     ca = window.document.model.coords[window.document.ca_rows]
@@ -216,7 +217,7 @@ def test_quitting_stops_a_running_build_at_once(qtbot: QtBot, open_window: Calla
     window = open_window("4YVS.cif.gz")  # 3,405 residues: a globe takes 10-20 s
     process = _building(qtbot, window, "globe", "molecular surface (distance transform)")  # one long call into scipy
     start = time.perf_counter()
-    window.quit_action.trigger()
+    window.files.quit_action.trigger()
     seconds = time.perf_counter() - start
     assert not window.isVisible() and seconds < 0.5
     assert process.exitcode == -signal.SIGKILL and not multiprocessing.active_children()
@@ -241,7 +242,7 @@ def test_opening_another_file_drops_the_running_build(qtbot: QtBot, open_window:
     window = open_window("1AYE.pdb.gz")
     panel = window.surface_panel
     old = _building(qtbot, window, "globe", "molecular surface")
-    window.open_file(DATA / "1L2Y.pdb.gz")  # Trp-cage, 20 residues
+    window.files.open_file(DATA / "1L2Y.pdb.gz")  # Trp-cage, 20 residues
     assert old.exitcode == -signal.SIGKILL
     [new] = multiprocessing.active_children()
     qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)

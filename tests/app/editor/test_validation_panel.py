@@ -90,13 +90,13 @@ def test_a_drag_is_regularized_on_release_in_one_undo_step(window: MainWindow) -
     assert not np.array_equal(document.model.coords, original)
     regularized = document.model.coords.copy()
     np.testing.assert_allclose(window.scene.meshes["atoms"].points, regularized, atol=1e-4)  # the view shows it
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     assert np.array_equal(document.model.coords, original)
-    window.redo_action.trigger()
+    window.editing.redo_action.trigger()
     assert np.array_equal(document.model.coords, regularized)
 
     # the same drag without regularization stretches bonds: the check above can fail
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     window.validation_panel.on_release.setChecked(False)
     _mouse_drag(window, _press_point(window), OFFSET)
     assert document.undo_stack.count() == 1
@@ -118,7 +118,7 @@ def test_the_cursor_waits_while_a_release_or_region_is_regularized(
     monkeypatch.setattr(document_module, "regularized", spy(document_module.regularized))
     monkeypatch.setattr(document_module, "regularize_region", spy(document_module.regularize_region))
     _mouse_drag(window, _press_point(window), OFFSET)
-    window.regularize_action.trigger()
+    window.editing.regularize_action.trigger()
     assert cursors == [Qt.CursorShape.WaitCursor, Qt.CursorShape.WaitCursor]
     assert QApplication.overrideCursor() is None  # restored afterwards
     assert window.document.undo_stack.count() == 2
@@ -140,7 +140,7 @@ def test_regularize_while_dragging_shows_regular_previews(window: MainWindow, qt
     _assert_panel_matches_the_model(window)
     interactor.InvokeEvent("LeftButtonReleaseEvent")
     assert document.undo_stack.count() == 1 and np.all(np.abs(_peptide_bonds(window) - 1.33) <= 0.05)
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     assert np.array_equal(document.model.coords, original)
 
 
@@ -159,9 +159,9 @@ def test_panel_counts_follow_the_model_during_and_after_drags(window: MainWindow
     interactor.InvokeEvent("LeftButtonReleaseEvent")
     assert sum(window.validation.report.counts.values()) > 10
     _assert_panel_matches_the_model(window)
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     _assert_panel_matches_the_model(window)
-    window.redo_action.trigger()
+    window.editing.redo_action.trigger()
     _assert_panel_matches_the_model(window)
     window.document.set_level(window.document.max_level)
     window.plotter.render()
@@ -169,17 +169,17 @@ def test_panel_counts_follow_the_model_during_and_after_drags(window: MainWindow
         _mouse_drag(window, _press_point(window), offset)
         assert window.validation.local
         _assert_panel_matches_the_model(window)
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     assert window.validation.local
     _assert_panel_matches_the_model(window)
-    assert window.open_file(DATA / "1TIM.pdb.gz")  # a new structure: a full check
+    assert window.files.open_file(DATA / "1TIM.pdb.gz")  # a new structure: a full check
     assert not window.validation.local
     _assert_panel_matches_the_model(window)
 
 
 def test_markers_show_a_bad_edit_until_the_region_is_regularized(window: MainWindow) -> None:
     document, mesh = window.document, window.markers.mesh
-    assert not window.regularize_action.isEnabled()  # nothing picked
+    assert not window.editing.regularize_action.isEnabled()  # nothing picked
     before = _marked_flags(window)
     assert mesh.n_points == len(_shown_marked(window)) == 0  # the file's one clash is mild
     window.validation_panel.on_release.setChecked(False)
@@ -194,14 +194,14 @@ def test_markers_show_a_bad_edit_until_the_region_is_regularized(window: MainWin
     assert window.plotter.actors["validation_markers"].GetVisibility()
 
     edited = document.model.coords.copy()
-    assert window.regularize_action.isEnabled()
-    window.regularize_action.trigger()  # Edit > Regularize Region: the picked point's residues
+    assert window.editing.regularize_action.isEnabled()
+    window.editing.regularize_action.trigger()  # Edit > Regularize Region: the picked point's residues
     assert document.undo_stack.count() == 2 and document.undo_stack.text(1).startswith("Regularize A:")
     after = _marked_flags(window)
     assert not any(f.kind != "clash" for f in after)  # every junction is ideal again
     assert {f.where for f in after} <= {f.where for f in before}  # at most the clash of the file is left
     assert mesh.n_points == len(_shown_marked(window))
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     assert np.array_equal(document.model.coords, edited) and mesh.n_points == len(shown)
 
 
@@ -217,7 +217,7 @@ def test_the_layer_toggle_hides_the_markers(window: MainWindow) -> None:
     assert window.markers.mesh.n_points > 10
     box.setChecked(True)
     assert actor.GetVisibility()
-    assert window.open_file(DATA / "1TIM.pdb.gz")  # the scene's rebuild keeps the markers
+    assert window.files.open_file(DATA / "1TIM.pdb.gz")  # the scene's rebuild keeps the markers
     assert window.plotter.actors["validation_markers"].GetVisibility()
     assert window.markers.mesh.n_points == len(_shown_marked(window))
 

@@ -14,6 +14,7 @@ from test_window import _mouse_drag, _window
 
 from app.editor.docks.validation import LISTED
 from app.editor.main_window import MainWindow
+from app.editor.persistence.recording import recording, replay
 from app.editor.scene.validation_markers import MARKED
 from core.geometry.triage import EDITED_OR_SEVERE, SEVERE, TriageFilter
 
@@ -118,10 +119,10 @@ def test_an_edit_s_problems_are_shown_as_new_until_undone(qtbot: QtBot) -> None:
     new_bonds = sum(f.kind == "peptide_bond" for f in made)
     assert panel.count_labels["peptide_bond"].text().startswith(f"{new_bonds} new, {new_bonds} of 75 junctions")
 
-    window.document.replay(window.document.recording())  # a restored session: the baseline is still the file
+    replay(window.document, recording(window.document))  # a restored session: the baseline is still the file
     assert window.validation.triaged.new == triaged.new and len(window.validation.triaged.flags) == len(triaged.flags)
 
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     assert set(window.validation.triaged.novelty) <= {"as read"} and _markers(window) == 0
     assert panel.offenders.topLevelItemCount() == 0
     assert panel.count_labels["peptide_bond"].text() == "0 of 75 junctions"

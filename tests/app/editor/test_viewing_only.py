@@ -14,6 +14,7 @@ from test_window import _mouse_drag, _pixels, _window
 
 from app.editor.docks.panels import BACKBONE_LAYERS
 from app.editor.document import Document
+from app.editor.persistence.recording import recording, replay
 from app.editor.scene.scene import Layer
 from app.main import main
 from core.protein.reading import read_structure
@@ -39,7 +40,7 @@ def test_the_document_views_dna_and_refuses_edits_with_the_reason(qapp: QApplica
     saved = document.save(tmp_path / "copy.pdb")  # saving unchanged is allowed: a copy, byte for byte
     assert saved.read_bytes() == gzip.decompress(DNA.read_bytes()) and not document.modified
     again = Document()
-    again.replay(document.recording())
+    replay(again, recording(document))
     assert not again.editable and np.array_equal(again.model.coords, document.model.coords)
 
 
@@ -50,7 +51,7 @@ def test_a_protein_document_is_editable_with_no_reason(ubiquitin: Document) -> N
 def test_dna_opens_in_the_window_for_viewing_and_surfaces(qtbot: QtBot, tmp_path: Path, errors: list[str]) -> None:
     window = _window(qtbot, DATA / "1UBQ.pdb.gz")
     window.comparison.add(DATA / "1UBQ.pdb.gz")
-    assert window.open_file(DNA) and errors == []
+    assert window.files.open_file(DNA) and errors == []
     assert window.comparison.items == []  # nothing to superpose them on
     document, scene = window.document, window.scene
     assert window.windowTitle() == "1BNA.pdb.gz[*] — ribbonwave"
@@ -68,13 +69,13 @@ def test_dna_opens_in_the_window_for_viewing_and_surfaces(qtbot: QtBot, tmp_path
 
     # editing is off, and the window says why
     panel = window.dimension_panel
-    assert window.status_labels["pick"].text() == REASON and window.status_labels["level"].text() == ""
+    assert window.status.labels["pick"].text() == REASON and window.status.labels["level"].text() == ""
     assert not panel.note.isHidden() and panel.note.text() == REASON
     for widget in (panel.slider, panel.spin, panel.segment, panel.kind, panel.analysis, panel.integers):
         assert not widget.isEnabled()
     assert panel.model_number.isHidden()  # one model
-    assert not any(action.isEnabled() for action in window.mode_actions.actions())
-    assert not window.regularize_action.isEnabled()
+    assert not any(action.isEnabled() for action in window.editing.mode_actions.actions())
+    assert not window.editing.regularize_action.isEnabled()
     assert all(not window.display_panel.layer_boxes[layer].isEnabled() for layer in BACKBONE_LAYERS)
     assert window.display_panel.layer_boxes[Layer.ATOMS].isEnabled()
     assert window.validation.report is None and window.validation_panel.timing.text() == REASON
@@ -104,20 +105,20 @@ def test_dna_opens_in_the_window_for_viewing_and_surfaces(qtbot: QtBot, tmp_path
     assert window.plotter.actors["surface"].mapper.dataset.n_cells > 1000
 
     # saving unchanged writes the file as read
-    assert window._write(tmp_path / "1bna.pdb")
+    assert window.files.write(tmp_path / "1bna.pdb")
     assert (tmp_path / "1bna.pdb").read_bytes() == gzip.decompress(DNA.read_bytes())
-    assert window._write(tmp_path / "1bna.cif")
+    assert window.files.write(tmp_path / "1bna.cif")
     np.testing.assert_array_equal(read_structure(tmp_path / "1bna.cif", require_protein=False).coords,
                                   document.structure.coords)
 
     # a session of it opens again for viewing; a protein makes everything editable again
-    saved = window.write_session(tmp_path / "dna")
-    assert window.open_file(DATA / "1UBQ.pdb.gz") and document.editable
+    saved = window.sessions.write_session(tmp_path / "dna")
+    assert window.files.open_file(DATA / "1UBQ.pdb.gz") and document.editable
     assert panel.slider.isEnabled() and panel.note.isHidden() and "tube" in scene.meshes
-    assert all(action.isEnabled() for action in window.mode_actions.actions())
+    assert all(action.isEnabled() for action in window.editing.mode_actions.actions())
     assert all(window.display_panel.layer_boxes[layer].isEnabled() for layer in BACKBONE_LAYERS)
-    assert window.open_session(saved) and not document.editable
-    assert window.status_labels["pick"].text() == REASON and errors == []
+    assert window.sessions.open_session(saved) and not document.editable
+    assert window.status.labels["pick"].text() == REASON and errors == []
 
 
 def test_the_command_line_opens_dna_but_not_at_a_level(qapp: QApplication, tmp_path: Path,

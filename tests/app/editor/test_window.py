@@ -17,8 +17,9 @@ from pytestqt.qtbot import QtBot
 from app import DEFAULT_STRUCTURE
 from app.editor.docks.panels import STEPS_PER_LEVEL
 from app.editor.document import Document
-from app.editor.drag import Mode
-from app.editor.main_window import RECENT_KEY, MainWindow
+from app.editor.features.files import RECENT_KEY
+from app.editor.interaction.drag import Mode
+from app.editor.main_window import MainWindow
 from app.editor.scene import molecule
 from app.editor.scene.molecule import Colouring
 from app.editor.scene.scene import TUBE_SIDES, Layer
@@ -111,7 +112,7 @@ def test_window_shows_the_structure(window: MainWindow) -> None:
     colours = {tuple(c) for c in tube.point_data["colours"]}
     assert set(molecule.SS_COLOURS.values()) <= colours
     assert "ions" not in window.plotter.actors  # ubiquitin has none
-    assert window.status_labels["segment"].text() == "chain A  MET1–GLY76 (76 residues)"
+    assert window.status.labels["segment"].text() == "chain A  MET1–GLY76 (76 residues)"
     assert window.history.model().rowCount() == 1  # "<structure as read>"
 
 
@@ -159,7 +160,7 @@ def test_large_multichain_entry(qtbot: QtBot) -> None:
     document, panel = window.document, window.dimension_panel
     assert panel.segment.count() == 20 and panel.segment.isEnabled()
     panel.segment.setCurrentIndex(5)  # chain G
-    assert document.segment == 5 and window.status_labels["segment"].text().startswith("chain G")
+    assert document.segment == 5 and window.status.labels["segment"].text().startswith("chain G")
     panel.slider.setValue(3 * STEPS_PER_LEVEL)
     samples = np.vstack([document.level_curve(g).samples for g in range(20)])
     np.testing.assert_allclose(window.scene.meshes["curve"].points, samples, atol=1e-4)
@@ -220,19 +221,19 @@ def test_dragging_a_control_point_edits_the_structure(
     atoms = window.scene.meshes["atoms"].points
     np.testing.assert_allclose(atoms, document.model.coords, atol=1e-4)
     assert window.isWindowModified()
-    assert window.status_labels["pick"].text().startswith(f"point {index} moves {expected} residues")
+    assert window.status.labels["pick"].text().startswith(f"point {index} moves {expected} residues")
     edited = document.model.coords.copy()
     tube_after = np.array(window.scene.meshes["tube"].points)
 
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     assert np.array_equal(document.model.coords, original) and not window.isWindowModified()
-    window.redo_action.trigger()
+    window.editing.redo_action.trigger()
     assert np.array_equal(document.model.coords, edited)
     np.testing.assert_array_equal(window.scene.meshes["tube"].points, tube_after)
 
     target = tmp_path / "edited.cif"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *args, **kwargs: (str(target), ""))
-    window.save_action.trigger()  # the first Save asks for a file name
+    window.files.save_action.trigger()  # the first Save asks for a file name
     np.testing.assert_allclose(read_structure(target).coords, edited, atol=6e-4)
     assert document.save_path == target and not window.isWindowModified()
 
@@ -260,7 +261,7 @@ def test_switching_to_the_ca_ribbon(window: MainWindow) -> None:
     np.testing.assert_allclose(window.scene.meshes["curve"].points, document.level_curve().samples, atol=1e-4)
     _drag_control_point(window, 4)
     assert not panel.kind.isEnabled()  # the kind cannot change under an edit
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     assert panel.kind.isEnabled()
 
 
@@ -287,13 +288,13 @@ def test_undo_puts_the_tube_back_exactly(window: MainWindow) -> None:
     tube = np.array(window.scene.meshes["tube"].points)
     _drag_control_point(window, 4)
     assert not np.array_equal(window.scene.meshes["tube"].points, tube)
-    window.undo_action.trigger()
+    window.editing.undo_action.trigger()
     np.testing.assert_array_equal(window.scene.meshes["tube"].points, tube)
 
 
 def test_tugging_the_curve_with_the_mouse(window: MainWindow) -> None:
     document = window.document
-    window.mode_actions.actions()[1].trigger()
+    window.editing.mode_actions.actions()[1].trigger()
     assert window.controller.mode is Mode.CURVE
     original = document.model.coords.copy()
     sample = document.level_curve().samples[120]
@@ -328,7 +329,7 @@ def test_escape_cancels_a_drag(window: MainWindow) -> None:
     interactor.SetEventInformation(start[0] + 50, start[1])
     interactor.InvokeEvent("MouseMoveEvent")
     assert not np.array_equal(document.model.coords, original)
-    window.cancel_action.trigger()
+    window.editing.cancel_action.trigger()
     interactor.InvokeEvent("LeftButtonReleaseEvent")
     assert np.array_equal(document.model.coords, original) and document.undo_stack.count() == 0
 
@@ -350,41 +351,41 @@ def test_closing_with_unsaved_edits_asks_first(qtbot: QtBot, window: MainWindow,
 def test_opening_another_file_asks_and_bad_files_are_reported(window: MainWindow, questions, errors) -> None:
     _drag_control_point(window, 3)
     questions.answer = questions.answer.Cancel
-    assert not window.open_file(DATA / "1TIM.pdb.gz")
+    assert not window.files.open_file(DATA / "1TIM.pdb.gz")
     assert window.document.structure.entry_id == "1UBQ"
     questions.answer = questions.answer.Discard
-    assert not window.open_file(DATA / "missing.pdb")
+    assert not window.files.open_file(DATA / "missing.pdb")
     assert errors == [f"{DATA / 'missing.pdb'}: no such file"] and window.document.structure.entry_id == "1UBQ"
-    assert window.open_file(DATA / "1TIM.pdb.gz")
+    assert window.files.open_file(DATA / "1TIM.pdb.gz")
     assert window.document.structure.entry_id == "1TIM" and window.document.undo_stack.count() == 0
     assert window.dimension_panel.segment.count() == 2
     assert window.windowTitle() == "1TIM.pdb.gz[*] — ribbonwave"
-    assert window.recent_files()[0] == str((DATA / "1TIM.pdb.gz").resolve())  # kept in the temporary settings
+    assert window.files.recent_files()[0] == str((DATA / "1TIM.pdb.gz").resolve())  # kept in the temporary settings
     assert window.settings.value(RECENT_KEY)
 
 
 def test_save_never_overwrites_without_asking(window: MainWindow, tmp_path: Path, monkeypatch, questions) -> None:
     source = tmp_path / "input.pdb"
     source.write_bytes((DATA / "1UBQ.pdb.gz").read_bytes())
-    assert window.open_file(source)
+    assert window.files.open_file(source)
     _drag_control_point(window, 3)
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *args, **kwargs: ("", ""))  # cancelled
-    assert not window.save()
+    assert not window.files.save()
     assert source.read_bytes() == (DATA / "1UBQ.pdb.gz").read_bytes()
     mmcif = "mmCIF (*.cif *.cif.gz *.mmcif)"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *args, **kwargs: (str(tmp_path / "out"), mmcif))
-    assert window.save()
+    assert window.files.save()
     assert (tmp_path / "out.cif").exists() and window.document.save_path == tmp_path / "out.cif"
     (tmp_path / "out.cif").write_text("an older file")
     window.document.save_path = None  # as after opening a file: Save asks for a name again
     questions.answer = questions.answer.No
-    assert not window.save()  # "out" + ".cif" exists: asked, and the answer was no
+    assert not window.files.save()  # "out" + ".cif" exists: asked, and the answer was no
     assert questions.asked[-1] == "out.cif exists. Replace it?"
     assert (tmp_path / "out.cif").read_text() == "an older file"
     questions.answer = questions.answer.Yes
-    assert window.save()
+    assert window.files.save()
     _drag_control_point(window, 5)
-    assert window.save()  # later saves go to the chosen file without asking
+    assert window.files.save()  # later saves go to the chosen file without asking
     np.testing.assert_allclose(read_structure(tmp_path / "out.cif").coords, window.document.model.coords, atol=6e-4)
 
 
@@ -474,7 +475,7 @@ def test_help_lists_the_commands(capsys: pytest.CaptureFixture[str]) -> None:
 def test_every_test_entry_opens_and_takes_a_drag(window: MainWindow, errors: list[str]) -> None:
     """Odd entries too: Cα-only, NMR with hydrogens, altlocs, gaps, insertion codes, ligands, DNA."""
     for path in sorted(DATA.glob("*.gz")):
-        assert window.open_file(path), errors
+        assert window.files.open_file(path), errors
         document = window.document
         if not document.editable:
             assert path.name == "1BNA.pdb.gz"  # DNA only: viewed, not edited (test_viewing_only.py)
@@ -483,7 +484,7 @@ def test_every_test_entry_opens_and_takes_a_drag(window: MainWindow, errors: lis
         _drag_control_point(window, len(window.scene.shown_control_points()) // 2, (30, 20), steps=1)
         assert document.undo_stack.count() == 1, path.name
         assert len(_moved_residues(document, original)) > 0, path.name
-        window.undo_action.trigger()
+        window.editing.undo_action.trigger()
         assert np.array_equal(document.model.coords, original), path.name
 
 
@@ -491,12 +492,12 @@ def test_an_empty_window_refuses_to_save(qtbot: QtBot, errors: list[str], tmp_pa
     window = MainWindow()
     qtbot.addWidget(window)
     window.show()
-    assert window.windowTitle() == "untitled[*] — ribbonwave" and window.status_labels["file"].text() == "no structure"
+    assert window.windowTitle() == "untitled[*] — ribbonwave" and window.status.labels["file"].text() == "no structure"
     unreadable = tmp_path / "notes.pdb"
     unreadable.write_text("not a structure\n")
-    assert not window.open_file(unreadable)
+    assert not window.files.open_file(unreadable)
     assert errors == [f"{unreadable}: not a structure file (no atoms found)"]
-    assert not window.save() and not window.save_as()
+    assert not window.files.save() and not window.files.save_as()
 
 
 @pytest.mark.parametrize("n_residues", [2, 3])
@@ -506,7 +507,7 @@ def test_a_chain_of_two_or_three_residues_opens_and_takes_a_drag(window: MainWin
     lines = [line for line in text.splitlines() if line.startswith("ATOM") and int(line[22:26]) <= n_residues]
     path = tmp_path / f"short{n_residues}.pdb"
     path.write_text("\n".join(lines) + "\nEND\n")
-    assert window.open_file(path) and errors == []
+    assert window.files.open_file(path) and errors == []
     assert len(window.document.ca_rows) == n_residues
     original = window.document.model.coords.copy()
     _drag_control_point(window, 1, (30, 20), steps=2)
@@ -569,7 +570,7 @@ def test_a_file_opened_from_the_command_line_is_a_recent_file(qapp: QApplication
     assert main([str(DATA / "1UBQ.pdb.gz"), "--screenshot", str(tmp_path / "shot.png")]) == 0
     window = MainWindow()
     try:
-        assert window.recent_files()[0] == str((DATA / "1UBQ.pdb.gz").resolve())
+        assert window.files.recent_files()[0] == str((DATA / "1UBQ.pdb.gz").resolve())
     finally:
         window.close()
 
@@ -578,9 +579,9 @@ def test_the_status_bar_follows_the_drag_mode(window: MainWindow, qtbot: QtBot) 
     window.activateWindow()
     qtbot.waitUntil(window.isActiveWindow)
     qtbot.keyClick(window, Qt.Key.Key_T)
-    assert window.status_labels["pick"].text().startswith("Drag the curve to tug it.")
+    assert window.status.labels["pick"].text().startswith("Drag the curve to tug it.")
     qtbot.keyClick(window, Qt.Key.Key_M)
-    assert window.status_labels["pick"].text().startswith("Click a control point to pick it")
+    assert window.status.labels["pick"].text().startswith("Click a control point to pick it")
 
 
 def test_choosing_another_chain_frames_it(qtbot: QtBot) -> None:

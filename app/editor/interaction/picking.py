@@ -1,7 +1,7 @@
 """The one adapter between VTK's interactor and the drag controller.
 
 Observers on the interactor's left-button and mouse-move events run before the camera's
-interactor style (higher priority). Each event becomes a :class:`~app.editor.drag.PointerEvent`
+interactor style (higher priority). Each event becomes a :class:`~app.editor.interaction.drag.PointerEvent`
 (the ray under the pointer, from the renderer's display-to-world transform); when the
 handler uses it, the event is aborted so the camera does not also rotate. Mouse events
 from Qt and events invoked on the interactor by tests take exactly this path.
@@ -16,7 +16,7 @@ import numpy as np
 import pyvista as pv
 from pyvista.core.utilities.misc import try_callback
 
-from app.editor.drag import PointerEvent
+from app.editor.interaction.drag import PointerEvent
 
 PRIORITY = 10.0
 """Above the interactor style's observers (priority 0)."""

@@ -1,7 +1,8 @@
-"""The 3D view as a PNG image of any size: supersampled, optionally on a transparent background.
+"""Images: the 3D view as a PNG image of any size, supersampled, optionally on a transparent
+background; and the whole window's screenshot.
 
-File ▸ Export Image (:class:`ExportImageDialog`), ``rw.screenshot`` and ``--export-image`` all
-go through :func:`export_view`. A view supersampled N times is rendered N x N times at the
+File ▸ Export Image (:class:`ImageExport` and its :class:`ExportImageDialog`), ``rw.screenshot``
+and ``--export-image`` all go through :func:`export_view`. A view supersampled N times is rendered N x N times at the
 size asked for, the camera shifted each time to another point of an N x N grid inside the
 pixel, and the frames are averaged: the same samples as a rendering N times larger averaged
 over each N x N block (a box filter), which smooths edges whatever the OpenGL, while lines,
@@ -19,8 +20,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from PySide6.QtCore import QBuffer, QByteArray, QIODevice, QSignalBlocker, Qt
-from PySide6.QtGui import QImage
+from PySide6.QtCore import QBuffer, QByteArray, QIODevice, QPoint, QSignalBlocker, Qt
+from PySide6.QtGui import QImage, QKeySequence, QPainter
 from PySide6.QtWidgets import (
     QApplication,
     QCheckBox,
@@ -32,6 +33,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QLineEdit,
+    QMainWindow,
     QMessageBox,
     QPushButton,
     QSpinBox,
@@ -44,6 +46,8 @@ from core.protein.writing import atomic_write
 if TYPE_CHECKING:
     from vtkmodules.vtkRenderingCore import vtkRenderer
 
+    from app.editor.features.files import Files
+    from app.editor.features.menus import Menus
     from app.editor.scene.view import View
 
 MAX_PIXELS = 2**25
@@ -245,6 +249,39 @@ class ExportImageDialog(QDialog):
             self.problem.setVisible(bool(problem))
             self.adjustSize()  # room for the message, or none left over
         self.buttons.button(QDialogButtonBox.StandardButton.Save).setEnabled(not problem)
+
+
+class ImageExport:
+    """File ▸ Export Image of ``window``'s 3D view ``plotter``, named after the structure by
+    ``files``, and screenshots of the whole window."""
+
+    def __init__(self, window: QMainWindow, plotter: View, files: Files, menus: Menus) -> None:
+        self.window = window
+        self.plotter = plotter
+        self.files = files
+        self.export_action = menus.action("&Export Image…", QKeySequence("Ctrl+E"), self.export_image_dialog)
+        menus.add("save", self.export_action)
+
+    def export_image_dialog(self) -> ExportImageDialog:
+        """File ▸ Export Image: the dialog of size, supersampling and background, shown (not waited for)."""
+        dialog = ExportImageDialog(self.plotter, self.files.suggested(".png"), self.window)
+        dialog.open()
+        return dialog
+
+    def save_screenshot(self, path: Path, *, overwrite: bool = False) -> None:
+        """Render the window, 3D view included, to a PNG image, atomically (raises OSError, or
+        FileExistsError for an existing file unless ``overwrite``)."""
+        write_png(self.grab_window(), Path(path), overwrite=overwrite)
+
+    def grab_window(self) -> QImage:
+        """An image of the whole window with the freshly rendered 3D view painted in."""
+        image = self.window.grab().toImage()
+        view = render_view(self.plotter, *self.plotter.window_size)
+        painter = QPainter(image)
+        corner = self.plotter.mapTo(self.window, QPoint(0, 0))
+        painter.drawImage(corner, view.scaled(self.plotter.size()))
+        painter.end()
+        return image
 
 
 @contextmanager

@@ -1,4 +1,5 @@
-"""The Help menu's texts: the mouse and keyboard reference and About with the versions in use.
+"""The Help menu: the mouse and keyboard reference and About with the versions in use, each
+in a box that does not block the editor.
 
 The keyboard table is read from the window's actions, so it always names the keys bound.
 """
@@ -7,9 +8,16 @@ from __future__ import annotations
 
 import platform
 from importlib.metadata import version
+from typing import TYPE_CHECKING
 
-from PySide6.QtCore import qVersion
+from PySide6.QtCore import Qt, qVersion
 from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtWidgets import QMainWindow, QMenu, QMessageBox
+
+from app import PROG
+
+if TYPE_CHECKING:
+    from app.editor.features.menus import Menus
 
 MOUSE = (
     ("Drag a control point", "move it in the plane facing you (one undo step)"),
@@ -22,6 +30,35 @@ MOUSE = (
     ("Point at anything", "name it in a tooltip and the status bar"),
     ("Sequence bar: click, drag, Shift+click", "select residues and centre on them"),
 )
+
+
+class Help:
+    """Help ▸ Mouse and Keyboard and About of ``window``."""
+
+    def __init__(self, window: QMainWindow, menus: Menus) -> None:
+        self.window = window
+        menus.add("help", menus.action("&Mouse and Keyboard", QKeySequence.StandardKey.HelpContents,
+                                       self.show_reference),
+                  menus.action(f"&About {PROG}", QKeySequence(), self.show_about))
+
+    def show_reference(self) -> QMessageBox:
+        """Help ▸ Mouse and Keyboard: the gestures and the keys bound (a window-modal box)."""
+        window = self.window
+        menus = [action for menu in window.menuBar().findChildren(QMenu) for action in menu.actions()]
+        return self._message("Mouse and keyboard", reference_html(list(dict.fromkeys(menus + window.actions()))))
+
+    def show_about(self) -> QMessageBox:
+        """Help ▸ About: what ribbonwave is and the versions of what it runs on."""
+        return self._message(f"About {PROG}", "<p><b>ribbonwave</b>: multiresolution (wavelet) analysis and "
+                             "editing of protein structures, after M. Carson, <i>Wavelets and molecular structure</i> "
+                             "(1996).</p><pre>" + about_text() + "</pre>")
+
+    def _message(self, title: str, html: str) -> QMessageBox:
+        box = QMessageBox(QMessageBox.Icon.NoIcon, title, html, QMessageBox.StandardButton.Close, self.window)
+        box.setTextFormat(Qt.TextFormat.RichText)
+        box.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
+        box.open()  # not blocking: the editor goes on behind it
+        return box
 
 
 def reference_html(actions: list[QAction]) -> str:

@@ -1,6 +1,6 @@
 """What is under the pointer: a control point, an atom or a residue, and its name for people.
 
-:func:`identify` casts the pointer's ray (a :class:`~app.editor.drag.PointerEvent`) at what
+:func:`identify` casts the pointer's ray (a :class:`~app.editor.interaction.drag.PointerEvent`) at what
 the view shows: the control points of the edited level curve first, then the atoms drawn
 (polymer atoms, ligands, ions), then the residues (their Cα, which the tube and the Cα
 trace pass through). Among the things the ray passes close to, the one nearest the eye
@@ -15,7 +15,7 @@ from typing import Literal
 import numpy as np
 
 from app.editor.document import Document
-from app.editor.drag import PICK_PIXELS, PointerEvent
+from app.editor.interaction.drag import PICK_PIXELS, PointerEvent
 from app.editor.scene.molecule import SS_NAMES
 
 RESIDUE_RADIUS = 2.0
@@ -87,7 +87,7 @@ def describe(document: Document, hit: Hit) -> str:
 
 def _front_hit(event: PointerEvent, points: np.ndarray, radius: float, allowed: np.ndarray | None = None) -> int | None:
     """The point nearest the eye among those whose sphere of ``radius`` Å the ray meets, or
-    that pass within :data:`~app.editor.drag.PICK_PIXELS` of it."""
+    that pass within :data:`~app.editor.interaction.drag.PICK_PIXELS` of it."""
     if len(points) == 0:
         return None
     depth, off, pixel = event.distances(points)

@@ -1,0 +1,92 @@
+"""Navigation and selection: View ▸ Reset View and Go to Residue (with its field in the tool
+bar), and residues selected and centred from the docks (the sequence bar, the Ramachandran
+plot, the validation list)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from PySide6.QtGui import QKeySequence
+from PySide6.QtWidgets import QLineEdit, QMainWindow, QStyle
+
+from core.protein.lookup import find_residues
+
+if TYPE_CHECKING:
+    from app.editor.document import Document
+    from app.editor.features.menus import Menus
+    from app.editor.scene.scene import Scene
+    from app.editor.scene.view import View
+    from core.geometry.validation import Flag
+
+
+class Navigation:
+    """Selecting residues of ``document`` and turning ``plotter``'s view, drawn by ``scene``, to them."""
+
+    def __init__(self, window: QMainWindow, document: Document, scene: Scene, plotter: View, menus: Menus) -> None:
+        self.window = window
+        self.document = document
+        self.scene = scene
+        self.plotter = plotter
+        self.go_to_action = menus.action("&Go to Residue…", QKeySequence("Ctrl+L"), self._focus_go_to)
+        self.go_to_action.setToolTip("Select a residue or a range and centre the view on it: A:45, 45, A:40-50")
+        self.reset_view_action = menus.action("&Reset View", QKeySequence("Ctrl+R"), self._reset_view,
+                                              window.style().standardIcon(QStyle.StandardPixmap.SP_BrowserReload))
+        self.go_to_field = QLineEdit()
+        self.go_to_field.setPlaceholderText("Go to residue (Ctrl+L)")
+        self.go_to_field.setToolTip(self.go_to_action.toolTip())
+        self.go_to_field.setClearButtonEnabled(True)
+        self.go_to_field.setMaximumWidth(190)
+        self.go_to_field.returnPressed.connect(self._go_to_typed)
+        menus.add("camera", self.reset_view_action, self.go_to_action)
+        menus.add_tools("camera", self.reset_view_action, self.go_to_field)
+
+    def select(self, rows: np.ndarray | list[int]) -> None:
+        """Select residues ``rows``; where they lie in one segment, that segment becomes the
+        edited one (framed: centre afterwards)."""
+        segments = {self.document.segment_of(int(row)) for row in rows}
+        if len(segments) == 1:
+            self.document.set_segment(segments.pop())
+        self.document.select(rows)
+
+    def select_and_centre(self, rows: np.ndarray, point: np.ndarray | None = None) -> None:
+        """Select residues ``rows`` (residue-table rows; see :meth:`select`) and centre the view
+        on ``point`` (Å; default: their Cα's mean)."""
+        rows = np.asarray(rows, dtype=np.int64)
+        if point is None and not len(rows):
+            return
+        self.select(rows)
+        self.scene.centre_on(self.document.model.coords[self.document.ca_rows[rows]].mean(axis=0)
+                             if point is None else point)
+        self.plotter.render()
+
+    def show_flag(self, flag: Flag) -> None:
+        """Centre the view on ``flag``'s marker and select its residues (see :meth:`select_and_centre`)."""
+        self.select_and_centre(np.array(flag.residues, dtype=np.int64), np.array(flag.position))
+
+    def go_to(self, text: str) -> np.ndarray:
+        """Select and centre on the residues named by ``text`` (``A:45``, ``45`` in the edited
+        chain, ``A:40-50``); returns their residue-table rows (raises ValueError)."""
+        if self.document.model is None:
+            raise ValueError("no structure is open")
+        chain = self.document.structure.segments[self.document.segment].chain
+        rows = find_residues(self.document.structure, text, chain)
+        self.select_and_centre(rows)
+        return rows
+
+    def _go_to_typed(self) -> None:
+        try:
+            self.go_to(self.go_to_field.text())
+        except ValueError as error:
+            self.window.statusBar().showMessage(str(error), 8000)
+            self.go_to_field.selectAll()
+            return
+        self.plotter.setFocus()  # the keys act on the view again
+
+    def _focus_go_to(self) -> None:
+        self.go_to_field.setFocus()
+        self.go_to_field.selectAll()
+
+    def _reset_view(self) -> None:
+        self.scene.reset_camera()
+        self.plotter.render()

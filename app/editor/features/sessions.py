@@ -1,0 +1,169 @@
+"""Sessions and crash recovery: File ▸ Open Session and Save Session, and the unsaved edits
+of an editor that did not close cleanly restored from its journal.
+
+A session (:mod:`app.editor.persistence.session`) holds the document's recording and what the
+window shows: the display layers and colouring, the camera and the compared structures. A
+restored document is journalled anew; compared structures are dropped first.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from PySide6.QtGui import QKeySequence
+from PySide6.QtWidgets import QFileDialog, QMainWindow, QMessageBox
+
+from app import PROG
+from app.editor.persistence import journal, records, session
+from app.editor.persistence.recording import recording, replay
+from app.editor.scene.molecule import Colouring
+from core.protein.structure import StructureError
+
+if TYPE_CHECKING:
+    from app.editor.docks.panels import DisplayPanel
+    from app.editor.document import Document
+    from app.editor.features.files import Files
+    from app.editor.features.menus import Menus
+    from app.editor.scene.overlay import Comparison
+    from app.editor.scene.scene import Scene
+    from app.editor.scene.view import View
+
+SESSION_FILTER = f"ribbonwave sessions (*{session.SUFFIX});;All files (*)"
+
+
+class Sessions:
+    """Sessions of ``window``'s ``document`` and its recovery from ``journal``; the view of a
+    session is that of ``plotter``, ``scene``, ``display_panel`` and ``comparison``."""
+
+    def __init__(self, window: QMainWindow, document: Document, journal: journal.Journal, files: Files,
+                 menus: Menus, *, plotter: View, scene: Scene, display_panel: DisplayPanel,
+                 comparison: Comparison) -> None:
+        self.window = window
+        self.document = document
+        self.journal = journal
+        self.files = files
+        self.plotter = plotter
+        self.scene = scene
+        self.display_panel = display_panel
+        self.comparison = comparison
+        self.open_session_action = menus.action("Open Sess&ion…", QKeySequence("Ctrl+Shift+O"),
+                                                self._open_session_dialog)
+        self.save_session_action = menus.action("Save Sessio&n…", QKeySequence("Ctrl+Alt+S"), self.save_session)
+        menus.add("session", self.open_session_action, self.save_session_action)
+        files.open_with(session.SUFFIX, self.open_session)
+
+    def open_session(self, path: Path, *, raise_errors: bool = False) -> bool:
+        """Open a session file after asking about unsaved edits: the structure, the undo history at
+        its position, the view and the compared structures (a bad file is reported in a dialog,
+        or raised as SessionError with ``raise_errors``)."""
+        if not self.files.maybe_save():
+            return False
+        try:
+            recorded, view = session.read(Path(path))
+            self._replay(recorded)
+        except (session.SessionError, StructureError) as error:
+            if raise_errors:
+                raise session.SessionError(str(error)) from None
+            QMessageBox.critical(self.window, PROG, str(error))
+            return False
+        self._apply_view(view)
+        self.files.add_recent(Path(path))
+        return True
+
+    def write_session(self, path: Path) -> Path:
+        """Save the session to ``path`` (``.rwsession`` added if missing); raises OSError."""
+        if self.document.model is None:
+            raise RuntimeError("no structure is open")
+        path = Path(path) if Path(path).name.endswith(session.SUFFIX) else Path(f"{path}{session.SUFFIX}")
+        session.write(path, recording(self.document), self._view())
+        return path
+
+    def save_session(self) -> bool:
+        """Ask for a file name and save the session there."""
+        if self.document.model is None:
+            return False
+        name, _ = QFileDialog.getSaveFileName(self.window, "Save Session", str(self.files.suggested(session.SUFFIX)),
+                                              SESSION_FILTER)
+        if not name:
+            return False
+        try:
+            self.write_session(Path(name))
+        except OSError as error:
+            QMessageBox.critical(self.window, PROG, f"cannot write {name}: {error.strerror or error}")
+            return False
+        return True
+
+    def restore_journal(self, path: Path) -> str:
+        """Restore the document a crashed editor journalled at ``path``; returns what was
+        restored (raises OSError, RecordError or StructureError)."""
+        recorded, damaged = records.read(Path(path))
+        self._replay(recorded)
+        Path(path).unlink(missing_ok=True)
+        stack = self.document.undo_stack
+        message = f"restored {stack.count()} undo step(s) of {self.document.path.name}, {stack.index()} done"
+        if damaged:
+            message += "; the journal was cut off after them (the step in progress at the crash is lost)"
+        self.window.statusBar().showMessage(message, 15000)
+        return message
+
+    def offer_recovery(self) -> None:
+        """If an editor ended without closing cleanly, offer to restore its unsaved edits."""
+        left = journal.orphans(self.journal.folder)
+        if not left:
+            return
+        buttons = QMessageBox.StandardButton
+        answer = QMessageBox.question(
+            self.window, PROG, "ribbonwave did not close cleanly last time. Restore the unsaved edits "
+            f"({time_label(left[0])})? Discard deletes them; Ignore keeps them for later.",
+            buttons.Yes | buttons.Discard | buttons.Ignore)
+        if answer == buttons.Yes:
+            try:
+                self.restore_journal(left[0])
+            except (OSError, records.RecordError, StructureError) as error:
+                QMessageBox.critical(self.window, PROG, f"cannot restore {left[0].name}: {error}")
+        elif answer == buttons.Discard:
+            left[0].unlink(missing_ok=True)
+
+    def _open_session_dialog(self) -> None:
+        folder = str(self.document.path.parent) if self.document.path else str(Path.home())
+        name, _ = QFileDialog.getOpenFileName(self.window, "Open Session", folder, SESSION_FILTER)
+        if name:
+            self.open_session(Path(name))
+
+    def _replay(self, recorded: list[records.Record]) -> None:
+        """The document as ``recorded`` says, journalled anew; compared structures are dropped."""
+        self.journal.discard()
+        while self.comparison.items:
+            self.comparison.remove(0)
+        replay(self.document, recorded)
+        self.journal.write_all()
+
+    def _view(self) -> session.View:
+        compared = [session.ComparedFile(item.path, item.source, item.chain, item.visible)
+                    for item in self.comparison.items]
+        camera = [list(map(float, vector)) for vector in self.plotter.camera_position]
+        return session.View(sorted(layer.name for layer in self.scene.layers), self.scene.colouring.value,
+                            self.scene.fat_helices, camera, compared)
+
+    def _apply_view(self, view: session.View) -> None:
+        for layer, box in self.display_panel.layer_boxes.items():
+            box.setChecked(layer.name in view.layers)
+        panel = self.display_panel
+        panel.colouring.setCurrentIndex(max(panel.colouring.findData(Colouring(view.colouring)), 0))
+        panel.fat.setChecked(view.fat_helices)
+        for item in view.compared:
+            try:
+                self.comparison.add(item.path, item.chain, item.source)
+            except (StructureError, ValueError) as error:
+                self.window.statusBar().showMessage(f"compared structure {item.path.name} left out: {error}", 15000)
+                continue
+            self.comparison.set_visible(len(self.comparison.items) - 1, item.visible)
+        self.plotter.camera_position = [tuple(vector) for vector in view.camera]
+        self.plotter.render()
+
+
+def time_label(path: Path) -> str:
+    """When the journal at ``path`` was last written, for people."""
+    return "last edit " + time.strftime("%Y-%m-%d %H:%M", time.localtime(path.stat().st_mtime))

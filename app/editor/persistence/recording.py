@@ -1,0 +1,69 @@
+"""A document as records and back: the file as read, every undo step and the current state
+(in the format of :mod:`app.editor.persistence.records`), for the crash-recovery journal and
+session files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from app.editor.commands import EditCommand
+from app.editor.document import Document
+from app.editor.persistence import records
+
+
+def state(document: Document) -> dict:
+    """The stack position, the clean position, the file names, level, segment and
+    multiresolution switch of ``document`` (the fields of an ``index`` record)."""
+    stack = document.undo_stack
+    return {"index": stack.index(), "clean": stack.cleanIndex(),
+            "path": str(document.path), "save_path": None if document.save_path is None else str(document.save_path),
+            "level": document.level, "segment": document.segment, "multiresolution": document.multiresolution}
+
+
+def recording(document: Document) -> list[records.Record]:
+    """``document`` as records: the file as read, every undo step, the current state."""
+    stack = document.undo_stack
+    steps = [records.push(k, stack.text(k), stack.command(k).edits) for k in range(stack.count())]
+    return [records.header(document.path, document.kind.value, document.source, document.model_number), *steps,
+            records.Record("index", state(document))]
+
+
+def replay(document: Document, recording: list[records.Record]) -> None:
+    """Make ``document`` what ``recording`` (:func:`recording`, or a journal) describes: the
+    file as read (the same model), the same undo history at the same position, bit for bit.
+    Views are told once, at the end. Raises StructureError for an unreadable embedded file."""
+    head, files, view = recording[0].fields, None, None
+    with document.rebuilding():
+        document.open(Path(head["path"]), head["kind"], records.source_of(recording[0]), records.model_of(head))
+        stack = document.undo_stack
+        for record in recording[1:]:
+            if record.kind == "push":
+                stack.setIndex(record.fields["at"])
+                stack.push(EditCommand(document, records.edits_of(record), record.fields["text"]))
+            elif record.kind == "index":
+                stack.setIndex(record.fields["index"])
+                files = view = record.fields
+            elif record.kind == "state":
+                view = record.fields
+        if files is not None:
+            _restore_files(document, files)
+        if view is not None:
+            document.segment = max(0, min(int(view["segment"]), len(document.model.ribbons) - 1))
+            document.multiresolution = bool(view["multiresolution"])
+            document.level = float(np.clip(view["level"], 0.0, document.max_level))
+
+
+def _restore_files(document: Document, state: dict) -> None:
+    """The clean position and the file names of an ``index`` record."""
+    stack = document.undo_stack
+    index = stack.index()
+    if state["clean"] >= 0:
+        stack.setIndex(state["clean"])
+        stack.setClean()
+    else:
+        stack.resetClean()
+    stack.setIndex(index)
+    document.path = Path(state["path"])
+    document.save_path = None if state["save_path"] is None else Path(state["save_path"])

@@ -1,0 +1,70 @@
+"""The window's status bar: the file, the edited chain, the level, the picked point (or the
+selection, or what a drag in the current mode does), the map's correlation and the name of
+what is under the pointer."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from PySide6.QtWidgets import QLabel, QStatusBar
+
+from app.editor.interaction.drag import Mode
+
+if TYPE_CHECKING:
+    from app.editor.document import Document
+    from app.editor.interaction.drag import DragController
+    from app.editor.map_correlation import LiveCorrelation
+
+LABELS = ("file", "segment", "level", "pick", "map", "hover")
+
+
+class StatusBar:
+    """The labels of ``bar`` that follow ``document``, the drag mode of ``controller`` and
+    ``correlation``; the hover's name is set from outside (:attr:`labels` ``["hover"]``)."""
+
+    def __init__(self, bar: QStatusBar, document: Document, controller: DragController,
+                 correlation: LiveCorrelation) -> None:
+        self.document = document
+        self.controller = controller
+        self.correlation = correlation
+        self.labels = {key: QLabel() for key in LABELS}
+        for key, label in self.labels.items():
+            bar.addWidget(label, 1 if key == "pick" else 0)
+        for signal in (document.fileChanged, document.loaded, document.levelChanged, document.segmentChanged,
+                       document.picked, document.selectionChanged):
+            signal.connect(self.update)
+        correlation.updated.connect(self._update_correlation)
+        self.update()
+
+    def update(self) -> None:
+        """Say what the document and the drag mode are now."""
+        document = self.document
+        labels = self.labels
+        if document.model is None:
+            labels["file"].setText("no structure")
+            return
+        structure = document.structure
+        labels["file"].setText(f"{document.path.name if document.path else ''}  ({structure.entry_id})")
+        if not document.editable:  # only viewed: say why instead of the segment, level and pick
+            labels["segment"].clear()
+            labels["level"].clear()
+            labels["pick"].setText(document.read_only_reason)
+            return
+        labels["segment"].setText(f"chain {document.segment_label(document.segment)}")
+        labels["level"].setText(f"level {document.shown_level():.2f} / {document.max_level:.2f}")
+        pick = document.pick
+        if len(document.selection) and pick is None:
+            first, last = (document.row_label(int(r)) for r in document.selection[[0, -1]])
+            labels["pick"].setText(f"selected {first if first == last else f'{first}–{last}'} "
+                                   f"({len(document.selection)} residues); Esc clears")
+            return
+        idle = ("Click a control point to pick it; drag it to edit." if self.controller.mode is Mode.POINT
+                else "Drag the curve to tug it.")
+        labels["pick"].setText(
+            f"{idle} Drag elsewhere to turn the view." if pick is None
+            else f"point {pick.index} moves {len(pick.residues)} residues: {document.residue_range(pick.residues)}"
+        )
+
+    def _update_correlation(self) -> None:
+        value = self.correlation.value
+        self.labels["map"].setText("" if value is None else f"map CC {value:.3f}")
