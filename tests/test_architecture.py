@@ -1,11 +1,13 @@
 """The architecture holds: the import-linter contracts of pyproject.toml (core in layers, no GUI in
-core, the command line and the editor apart), and the headless commands load no GUI package."""
+core, the command line and the editor apart), no import circle in app or core, and the headless
+commands load no GUI package."""
 
 import json
 import subprocess
 import sys
 from pathlib import Path
 
+import grimp
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -18,6 +20,19 @@ def test_import_linter_contracts_hold() -> None:
         [str(lint_imports), "--no-cache"], cwd=ROOT, capture_output=True, text=True, check=False
     )
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_no_import_circle_in_app_or_core() -> None:
+    """No import circle among the modules of app and core, imports under TYPE_CHECKING included:
+    each module can be read, and changed, before the modules it imports."""
+    graph = grimp.build_graph("app", "core", cache_dir=None)
+    circles: dict[frozenset[str], tuple[str, ...]] = {}
+    for importer in sorted(graph.modules):
+        for imported in sorted(graph.find_modules_directly_imported_by(importer)):
+            back = graph.find_shortest_chain(importer=imported, imported=importer)
+            if back is not None:
+                circles.setdefault(frozenset(back), (importer, *back))
+    assert not circles, "import circles:\n" + "\n".join(" -> ".join(circle) for circle in circles.values())
 
 
 def test_importing_all_of_core_loads_no_gui_package() -> None:
