@@ -66,11 +66,11 @@ from app.editor.live_validation import LiveValidation
 from app.editor.map_correlation import LiveCorrelation
 from app.editor.persistence import journal, records, session
 from app.editor.picking import PRIORITY, PointerAdapter
+from app.editor.scene.layers.validation_markers import ValidationMarkers
 from app.editor.scene.map_mesh import MapMesh
 from app.editor.scene.molecule import Colouring
 from app.editor.scene.overlay import Compared, Comparison, ComparisonView
 from app.editor.scene.scene import Layer, Scene
-from app.editor.scene.validation_markers import ValidationMarkers
 from app.editor.scene.view import new_view
 from app.editor.scripting import EditorAPI
 from core.geometry.validation import Flag
