@@ -79,7 +79,7 @@ class Stage(Protocol):
 
 class SceneLayer:
     """One representation of the document in the scene. Every hook does nothing unless a layer
-    says otherwise; the scene calls them only once :meth:`build` has run for the structure."""
+    says otherwise; the scene calls them only on the layers it has built."""
 
     switch: ClassVar[Layer | None] = None
     """The :class:`Layer` that shows and hides it (None: shown whenever it has something to show)."""
