@@ -54,7 +54,7 @@ from app.editor.persistence import journal
 from app.editor.scene.map_mesh import MapMesh
 from app.editor.scene.overlay import Comparison, ComparisonView
 from app.editor.scene.scene import Scene
-from app.editor.scene.validation_markers import ValidationMarkers
+from app.editor.scene.layers.validation_markers import ValidationMarkers
 from app.editor.scene.view import new_view
 from app.editor.scripting import EditorAPI
 from app.editor.status_bar import StatusBar

@@ -27,7 +27,7 @@ from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QVBoxLayout, QWidg
 
 from app.editor.document import Document
 from app.editor.live_validation import LiveValidation
-from app.editor.scene.scene import PICKED_COLOUR
+from app.editor.scene.layers.control_points import PICKED_COLOUR
 from core.geometry.ramachandran import OUTLIER, RAMACHANDRAN, RAMACHANDRAN_CLASSES, ramachandran_region
 from core.geometry.topology import topology
 from core.geometry.validation import phi_psi

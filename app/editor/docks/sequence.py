@@ -17,8 +17,9 @@ from PySide6.QtGui import QColor, QFont, QFontDatabase, QMouseEvent, QPainter, Q
 from PySide6.QtWidgets import QScrollArea, QToolTip, QWidget
 
 from app.editor.document import Document
+from app.editor.scene.layers.control_points import PICKED_COLOUR
+from app.editor.scene.layers.selection import SELECTION_COLOUR
 from app.editor.scene.molecule import SS_COLOURS, SS_NAMES
-from app.editor.scene.scene import PICKED_COLOUR, SELECTION_COLOUR
 
 NUMBER_EVERY = 10
 

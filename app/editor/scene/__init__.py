@@ -1,3 +1,4 @@
-"""The 3D view: the widget that draws one frame per event, the document's layers as pyvista
-meshes updated in place, and the numpy geometry behind them (tubes, curves, atoms, compared
-structures, validation markers)."""
+"""The 3D view: the widget that draws one frame per event (``view``, ``widget_view`` and what
+both share, ``view_base``), the scene that draws the document layer by layer (``scene``, its
+layers in ``layers/``), the compared structures (``overlay``) and the density map
+(``map_mesh``), and the numpy geometry behind them (``curves``, ``tube``, ``molecule``)."""

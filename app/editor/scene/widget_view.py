@@ -1,5 +1,6 @@
 """The 3D view in pyvistaqt's ``QtInteractor`` (a ``QOpenGLWidget``), for platforms where VTK
-cannot draw into a native child window (see :mod:`app.editor.scene.view`)."""
+cannot draw into a native child window (see :mod:`app.editor.scene.view`;
+what both views share is :class:`~app.editor.scene.view_base.View`)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QWidget
 from pyvistaqt import QtInteractor
 
-from app.editor.scene.view import View
+from app.editor.scene.view_base import View
 
 
 class WidgetView(View, QtInteractor):

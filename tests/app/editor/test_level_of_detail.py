@@ -11,7 +11,8 @@ from PySide6.QtWidgets import QApplication
 from pytestqt.qtbot import QtBot
 
 from app.editor.main_window import MainWindow
-from app.editor.scene.scene import MOVING_RING_STEP, MOVING_SIDE_STEP, STILL_AFTER_MS, TUBE_SIDES, Layer
+from app.editor.scene.layers.tube import MOVING_RING_STEP, MOVING_SIDE_STEP, TUBE_SIDES
+from app.editor.scene.scene import STILL_AFTER_MS, Layer
 
 Opener = Callable[[str], MainWindow]
 """The ``open_window`` fixture: a shown window on a file of tests/data."""

@@ -13,7 +13,9 @@ from pytestqt.qtbot import QtBot
 
 from app.editor.interaction.drag import HANDLE_BOX, HANDLE_RADIUS
 from app.editor.main_window import MainWindow
-from app.editor.scene.scene import MIN_POINT_PIXELS, TUBE_SIDES, Layer, Others
+from app.editor.scene.layers.control_points import MIN_POINT_PIXELS
+from app.editor.scene.layers.tube import TUBE_SIDES, TubeLayer
+from app.editor.scene.scene import Layer, Others
 
 Opener = Callable[[str], MainWindow]
 """The ``open_window`` fixture: a shown window on a file of tests/data."""
@@ -280,7 +282,7 @@ def test_other_chains_dimmed_hidden_and_shown(open_window: Opener) -> None:
     assert scene.others is Others.DIMMED and Others(window.display_panel.others.currentData()) is Others.DIMMED
     document = window.document
     tube = window.scene.meshes["tube"]
-    rings = window.scene._ring_start  # noqa: SLF001 (the tube's layout)
+    rings = window.scene.part(TubeLayer).ring_start  # the tube's layout
     chains = [s.chain for s in document.structure.segments]
     k = next(k for k, chain in enumerate(chains) if chain != chains[0])
     edited, other = (slice(rings[g] * TUBE_SIDES, rings[g + 1] * TUBE_SIDES) for g in (0, k))

@@ -243,10 +243,11 @@ def test_the_columns_fit_their_content_and_names_are_whole(ubiquitin: MainWindow
 
 def test_compared_colours_are_distinct_from_every_editor_colour() -> None:
     """The third compared structure was the purple of the control points (#17)."""
-    from app.editor.scene import molecule, overlay, scene
+    from app.editor.scene import molecule, overlay
+    from app.editor.scene.layers import ca_trace, control_points, level_curve, selection
 
-    editor = [*molecule.SS_COLOURS.values(), scene.CURVE_COLOUR, scene.OTHER_CURVE_COLOUR, scene.POINT_COLOUR,
-              scene.PICKED_COLOUR, scene.SELECTION_COLOUR, scene.POLYGON_COLOUR, scene.CA_STICK_COLOUR,
-              (255, 255, 255), (223, 229, 236)]
+    editor = [*molecule.SS_COLOURS.values(), level_curve.CURVE_COLOUR, level_curve.OTHER_CURVE_COLOUR,
+              control_points.POINT_COLOUR, control_points.PICKED_COLOUR, selection.SELECTION_COLOUR,
+              control_points.POLYGON_COLOUR, ca_trace.CA_STICK_COLOUR, (255, 255, 255), (223, 229, 236)]
     distances = np.linalg.norm(np.array(overlay.PALETTE)[:, None] - np.array(editor)[None], axis=2)
     assert distances.min() >= 60

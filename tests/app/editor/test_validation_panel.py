@@ -14,8 +14,8 @@ from test_window import _display, _mouse_drag, _window
 from app.editor import document as document_module, live_validation
 from app.editor.docks.validation import CHECKED_NAMES, LISTED
 from app.editor.main_window import MainWindow
+from app.editor.scene.layers.validation_markers import MARKED, severity_colours
 from app.editor.scene.scene import Layer
-from app.editor.scene.validation_markers import MARKED, severity_colours
 from core.geometry.topology import topology
 from core.geometry.triage import Baseline, Triaged, triage
 from core.geometry.validation import validate

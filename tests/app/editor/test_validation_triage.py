@@ -15,7 +15,7 @@ from test_window import _mouse_drag, _window
 from app.editor.docks.validation import LISTED
 from app.editor.main_window import MainWindow
 from app.editor.persistence.recording import recording, replay
-from app.editor.scene.validation_markers import MARKED
+from app.editor.scene.layers.validation_markers import MARKED
 from core.geometry.triage import EDITED_OR_SEVERE, SEVERE, TriageFilter
 
 DATA = Path(__file__).resolve().parents[2] / "data"

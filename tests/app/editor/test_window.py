@@ -21,8 +21,9 @@ from app.editor.features.files import RECENT_KEY
 from app.editor.interaction.drag import Mode
 from app.editor.main_window import MainWindow
 from app.editor.scene import molecule
+from app.editor.scene.layers.tube import TUBE_SIDES
 from app.editor.scene.molecule import Colouring
-from app.editor.scene.scene import TUBE_SIDES, Layer
+from app.editor.scene.scene import Layer
 from app.main import COMMANDS, main
 from core.curves.splines import spline_space
 from core.protein.reading import read_structure

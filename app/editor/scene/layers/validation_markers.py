@@ -1,7 +1,8 @@
 """Markers on the model at the bad peptide junctions and the clashes, coloured by severity.
 
-One actor of its own (``validation_markers``, the scene's :attr:`~app.editor.scene.scene.Layer.VALIDATION`
-layer): a point set drawn as spheres, one point per junction or clash flag that the live
+A layer of the scene (:attr:`~app.editor.scene.layers.base.Layer.VALIDATION`) that adds itself
+to it, since it draws the live report, which the scene does not know. One actor of its own
+(``validation_markers``): a point set drawn as spheres, one point per junction or clash flag that the live
 report's triage filter shows (:attr:`~app.editor.live_validation.LiveValidation.triaged`),
 rewritten in place when the report or the filter changes. Ramachandran outliers are listed
 in the validation panel but not marked (a residue, not a place between atoms).
@@ -11,11 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
-from PySide6.QtCore import QObject
 from vtkmodules.util.numpy_support import vtk_to_numpy
 
 from app.editor.live_validation import LiveValidation
-from app.editor.scene.scene import Layer, Scene
+from app.editor.scene.layers.base import Layer, SceneLayer
+from app.editor.scene.scene import Scene
 from core.geometry.validation import Flag
 
 NAME = "validation_markers"
@@ -41,17 +42,23 @@ def marked(flags: tuple[Flag, ...]) -> tuple[np.ndarray, np.ndarray]:
     return positions, np.array([f.severity for f in chosen], dtype=float)
 
 
-class ValidationMarkers(QObject):
+class ValidationMarkers(SceneLayer):
     """Draws the junction and clash flags shown of the live report into the scene's plotter."""
+
+    switch = Layer.VALIDATION
+    needs_backbone = False
+    names = (NAME,)
 
     def __init__(self, validation: LiveValidation, scene: Scene) -> None:
         super().__init__(scene)
         self.validation = validation
-        self.scene = scene
         self.mesh = pv.PolyData()
         validation.updated.connect(self.refresh)
         validation.triageChanged.connect(lambda: self.refresh(render=True))
-        scene.document.loaded.connect(self.refresh)  # after the scene's rebuild, which removes every actor
+        scene.add_layer(self)
+
+    def build(self) -> None:
+        """Draw the markers again (the scene's rebuild removed every actor)."""
         self.refresh()
 
     def refresh(self, render: bool = False) -> None:
@@ -81,7 +88,7 @@ class ValidationMarkers(QObject):
             self.mesh.shallow_copy(_points(positions, colours))
         else:
             changed = False
-        visible = Layer.VALIDATION in self.scene.layers
+        visible = self.visible
         self.scene.actors[NAME].SetVisibility(visible)
         if visible and (render or (self.validation.late and changed and not self.scene.moving)):
             self.scene.plotter.render()  # (while something moves, its next frame or the still one shows them)

@@ -1,0 +1,84 @@
+"""Ligands (balls and sticks, carbon in green: ``ligand_balls``, ``ligand_sticks``) and ions (a
+large ball each: ``ions``), two layers switched on their own; also drawn for a structure that
+is only viewed (no backbone). Edits move neither."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+
+from app.editor.scene import molecule
+from app.editor.scene.layers.base import SHINY, Layer, SceneLayer
+from app.editor.scene.layers.meshes import bond_lines, collapse, glyph_rows, glyphs, move_glyphs
+
+LIGAND_ATOM_RADIUS = 0.35
+ION_RADIUS = 1.1
+
+
+class LigandsLayer(SceneLayer):
+    """The atoms of ligands (not ions, not water) as small balls and bond sticks."""
+
+    switch = Layer.LIGANDS
+    needs_backbone = False
+    names = ("ligand_balls", "ligand_sticks")
+    lines_as_tubes = ("ligand_sticks",)
+
+    def build(self) -> None:
+        table = self.document.structure.atoms
+        coords = self.document.model.coords
+        _, self._rows = molecule.ions_and_ligands(self.document.structure)
+        carbon = molecule.LIGAND_CARBON
+        self.meshes["ligand_balls"] = glyphs(coords[self._rows], LIGAND_ATOM_RADIUS,
+                                             molecule.element_colours(table.element[self._rows], carbon))
+        self.add("ligand_balls", scalars="colours", rgb=True, **SHINY)
+        bonds = molecule.bonds(coords, table.element, table.altloc, self._rows)
+        self.meshes["ligand_sticks"] = bond_lines(coords, bonds, molecule.element_colours(table.element, carbon))
+        self.add("ligand_sticks", scalars="colours", rgb=True, line_width=5.0, render_lines_as_tubes=True)
+
+    def atom_rows(self) -> np.ndarray:
+        return self._rows
+
+    def conceal(self, chain: str) -> None:
+        other = self.document.structure.atoms.chain != chain
+        if self.meshes["ligand_sticks"].n_points:
+            collapse(self.meshes["ligand_sticks"], np.flatnonzero(other))
+        _conceal_glyphs(self.meshes["ligand_balls"], other[self._rows])
+
+    def restore(self) -> None:
+        coords = self.document.model.coords
+        if self.meshes["ligand_balls"].n_points:
+            move_glyphs(self.meshes["ligand_balls"], slice(None), coords[self._rows])
+        if self.meshes["ligand_sticks"].n_points:
+            self.write("ligand_sticks", slice(None), coords)
+
+
+class IonsLayer(SceneLayer):
+    """Ions (a non-polymer, non-water group of one heavy atom) as balls."""
+
+    switch = Layer.IONS
+    needs_backbone = False
+    names = ("ions",)
+
+    def build(self) -> None:
+        elements = self.document.structure.atoms.element
+        self._rows, _ = molecule.ions_and_ligands(self.document.structure)
+        self.meshes["ions"] = glyphs(self.document.model.coords[self._rows], ION_RADIUS,
+                                     molecule.element_colours(elements[self._rows]))
+        self.add("ions", scalars="colours", rgb=True, **SHINY)
+
+    def atom_rows(self) -> np.ndarray:
+        return self._rows
+
+    def conceal(self, chain: str) -> None:
+        _conceal_glyphs(self.meshes["ions"], self.document.structure.atoms.chain[self._rows] != chain)
+
+    def restore(self) -> None:
+        if self.meshes["ions"].n_points:
+            move_glyphs(self.meshes["ions"], slice(None), self.document.model.coords[self._rows])
+
+
+def _conceal_glyphs(mesh: pv.PolyData, other: np.ndarray) -> None:
+    """Collapse the glyphs of ``mesh`` where ``other`` (one per glyph) is true."""
+    rows = np.flatnonzero(other)
+    if len(rows):
+        collapse(mesh, glyph_rows(rows, len(other)))
