@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import itertools
 import os
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -136,9 +137,14 @@ class Journal(QObject):
 
     def _open_file(self) -> None:
         self.folder.mkdir(parents=True, exist_ok=True)
-        stamp = time.strftime("%Y%m%d-%H%M%S")
-        self.path = self.folder / f"journal-{stamp}-{os.getpid()}-{id(self):x}{SUFFIX}"
-        self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o600)
+        stem = f"journal-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}-{id(self):x}"
+        for again in itertools.count():  # a journal kept within the same second keeps its name
+            self.path = self.folder / f"{stem}{f'-{again}' if again else ''}{SUFFIX}"
+            try:
+                self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o600)
+                break
+            except FileExistsError:
+                continue
         fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # held while this editor runs
         document = self.document
         os.write(self._fd, records.MAGIC + records.encode(records.header(document.path, document.kind.value,

@@ -133,6 +133,18 @@ def test_an_unattended_close_keeps_unsaved_edits(qtbot: QtBot, questions) -> Non
     assert journal.orphans(path.parent) == [path]  # nobody holds it any more
 
 
+def test_a_journal_kept_leaves_room_for_the_next_in_the_same_second(qtbot: QtBot) -> None:
+    """A script that opens a session over unsaved edits keeps their journal and starts another
+    at once: the new one gets a name of its own (it took the kept one's and failed)."""
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    _edit(window, 3)
+    kept = window.journal.path
+    window.journal.keep()
+    _edit(window, 4)
+    assert window.journal.path != kept and kept.exists() and window.journal.path.exists()
+    assert [r.kind for r in _journal_records(window)].count("push") == 1
+
+
 def test_the_next_start_offers_to_restore(qtbot: QtBot, questions) -> None:
     crashed = _window(qtbot, DATA / "1UBQ.pdb.gz")
     for k in range(4):
