@@ -172,20 +172,6 @@ def fit_map_levels(
     networks: list[ElasticNetwork] = []  # at rest as the levels begin (after the domains)
     rows = _segment_rows(model, segments)
 
-    def objective(network: ElasticNetwork, correlation: Callable[[np.ndarray], tuple[float, np.ndarray]]
-                  ) -> Callable[[np.ndarray], tuple[float, float, np.ndarray]]:
-        begun = model.coords[rows]
-
-        def evaluate(coords: np.ndarray) -> tuple[float, float, np.ndarray]:
-            """The objective, the CC and the objective's gradient per atom at ``coords``."""
-            cc, total = correlation(coords)
-            energy, pull = network.gradient(coords[ca])
-            total[ca] -= stiffness * pull
-            moved = coords[rows] - begun
-            total[rows] -= (2.0 * hold / len(rows)) * moved
-            return cc - stiffness * energy - hold * float(np.sum(moved**2)) / len(rows), cc, total
-        return evaluate
-
     for level in levels:
         if cancelled():
             return
@@ -198,7 +184,8 @@ def fit_map_levels(
         start = time.perf_counter()
         at = target.blurred(level_resolution(model, segments, level, target.resolution))
         correlation = atom_correlation(model, at)
-        cc, planned = max((_fit_level(model, segments, level, objective(network, correlation), cancelled)
+        cc, planned = max((_fit_level(model, segments, level, _restrained(correlation, network, ca, stiffness, rows,
+                                                                           model.coords[rows], hold), cancelled)
                            for network in networks), key=lambda fit: fit[0])
         if cancelled():
             return
@@ -300,20 +287,12 @@ def refine(
     network = ElasticNetwork(model.coords[ca])
     rows = _segment_rows(model, segments)
 
-    def restrained(coords: np.ndarray, begun: np.ndarray) -> tuple[float, np.ndarray]:
-        cc, gradient = correlation(coords)
-        energy, pull = network.gradient(coords[ca])
-        gradient[ca] -= stiffness * pull
-        moved = coords[rows] - begun[rows]
-        gradient[rows] -= (2.0 * hold / len(rows)) * moved
-        return cc - stiffness * energy - hold * float(np.sum(moved**2)) / len(rows), gradient
-
     done: list[Edit] = []
     for _ in range(cycles):
         if cancelled():
             break
-        begun = model.coords.copy()
-        moved = refine_real_space(model, segments, partial(restrained, begun=begun), cancelled=cancelled)
+        evaluate = _restrained(correlation, network, ca, stiffness, rows, model.coords[rows], hold)
+        moved = refine_real_space(model, segments, partial(_without_cc, evaluate), cancelled=cancelled)
         for edit in moved:
             model.apply(edit)
         done.extend(moved)
@@ -323,6 +302,30 @@ def refine(
                 model.apply(step)
                 done.append(step)
     return per_segment(done)
+
+
+def _restrained(correlation: Callable[[np.ndarray], tuple[float, np.ndarray]], network: ElasticNetwork,
+                ca: np.ndarray, stiffness: float, rows: np.ndarray, begun: np.ndarray, hold: float
+                ) -> Callable[[np.ndarray], tuple[float, float, np.ndarray]]:
+    """The objective of a fit at atoms ``coords``: the CC less ``stiffness`` times the energy of
+    ``network`` (on the Cα ``ca``) and less ``hold`` times the mean squared move of the atoms
+    ``rows`` from ``begun``; returns it, the CC and its gradient per atom."""
+
+    def evaluate(coords: np.ndarray) -> tuple[float, float, np.ndarray]:
+        cc, total = correlation(coords)
+        energy, pull = network.gradient(coords[ca])
+        total[ca] -= stiffness * pull
+        moved = coords[rows] - begun
+        total[rows] -= (2.0 * hold / len(rows)) * moved
+        return cc - stiffness * energy - hold * float(np.sum(moved**2)) / len(rows), cc, total
+    return evaluate
+
+
+def _without_cc(evaluate: Callable[[np.ndarray], tuple[float, float, np.ndarray]], coords: np.ndarray
+                ) -> tuple[float, np.ndarray]:
+    """``evaluate``'s objective and gradient at ``coords``, as a score of the refinement."""
+    value, _, gradient = evaluate(coords)
+    return value, gradient
 
 
 def _segment_rows(model: EditableModel, segments: Sequence[int]) -> np.ndarray:
