@@ -35,6 +35,9 @@ model's density cut the same way: its ripples, a resolution wide, span residues 
 ubiquitin 0.72 Å out of its own X-ray-like 10 Å map (0.27-0.36 Å cut as the map is); at
 finer cuts they are atomic detail, the Gaussian model does as well (0.17 Å at 3 Å) and is
 five times cheaper on the fine grid (an MTZ map at 2.5 Å)."""
+SPREAD_VARIANCE = 1.0 / 3.0
+"""Grid steps²: the variance that spreading an atom by a cubic B-spline adds along each axis,
+taken from the blur that follows."""
 ATOM_SIGMA = 0.6
 """Å: an atom's own width in a map cut sharply in Fourier space (B ≈ 30 Å²), before the cut."""
 
@@ -128,9 +131,10 @@ class MapTarget:
     def density(self, coords: np.ndarray, occupancy: np.ndarray | None = None) -> np.ndarray:
         """The model's density on the grid for atoms at ``coords`` (n, 3), each weighted by
         its ``occupancy`` (n,; default 1), as a map shows a partly occupied atom."""
-        flat, keep, weight, _ = self._corners(coords)
+        flat, keep, weights, _ = self._stencil(coords)
+        weight = np.einsum("na,nb,nc->nabc", *weights).reshape(len(coords), -1)
         if occupancy is not None:
-            weight = weight * occupancy
+            weight = weight * occupancy[:, None]
         spread = np.bincount(flat[keep], weight[keep], int(np.prod(self.shape)))
         return self._blur(spread.reshape(self.shape).astype(np.float64))  # integers when no atom is on the grid
 
@@ -145,10 +149,12 @@ class MapTarget:
         """The CC (as :meth:`correlation`) and its gradient (n, 3) with respect to each atom's
         position (1/Å).
 
-        The density spreads each atom trilinearly and blurs; both are adjoint to what the
-        gradient does (the blur is symmetric, trilinear spreading the transpose of trilinear
-        interpolation), so the exact gradient is that of the trilinear interpolant of the
-        blurred ∂CC/∂density at each atom."""
+        The density spreads each atom by a cubic B-spline and blurs; both are adjoint to what
+        the gradient does (the blur is symmetric, the spreading the transpose of B-spline
+        interpolation), so the exact gradient is that of the B-spline interpolant of the
+        blurred ∂CC/∂density at each atom, smooth as the CC is (spread trilinearly, the CC
+        was kinked at every grid plane, and L-BFGS ended wherever the last bits of the start
+        led it among the kinks)."""
         model = self.density(coords, occupancy)
         model -= model.mean()
         norm = _norm(model)
@@ -156,8 +162,11 @@ class MapTarget:
             return 0.0, np.zeros_like(coords)
         cc = float(np.sum(model * self._target) / (norm * self._target_norm))
         field = self._blur(self._target / (norm * self._target_norm) - cc * model / norm**2).ravel()
-        flat, keep, _, slopes = self._corners(coords)
-        gradient = np.einsum("cn,cni->ni", np.where(keep, field[flat], 0.0), slopes) / self.spacing
+        flat, keep, (x, y, z), (dx, dy, dz) = self._stencil(coords)
+        around = np.where(keep, field[flat], 0.0).reshape(len(coords), 4, 4, 4)
+        gradient = np.stack([np.einsum("nabc,na,nb,nc->n", around, dx, y, z),
+                             np.einsum("nabc,na,nb,nc->n", around, x, dy, z),
+                             np.einsum("nabc,na,nb,nc->n", around, x, y, dz)], axis=1) / self.spacing
         return cc, gradient if occupancy is None else gradient * occupancy[:, None]
 
     def _blur(self, grid: np.ndarray) -> np.ndarray:
@@ -166,7 +175,8 @@ class MapTarget:
         (each atom :data:`ATOM_SIGMA` wide, and as much wider as the resolution asked is
         coarser than the cut), so that it ripples as the map does. Either is its own adjoint."""
         if self.cut is None:
-            return ndimage.gaussian_filter(grid, self.sigma / self.spacing, mode="constant", truncate=3.0)
+            return ndimage.gaussian_filter(grid, np.sqrt(self.sigma**2 - SPREAD_VARIANCE * self.spacing**2) / self.spacing,
+                                           mode="constant", truncate=3.0)
         padded = np.pad(grid, [(self._pad, m - n - self._pad) for n, m in zip(self.shape, self._padded)])
         filtered = fft.irfftn(fft.rfftn(padded) * self._cut_filter, self._padded, axes=(0, 1, 2))
         return filtered[tuple(slice(self._pad, self._pad + n) for n in self.shape)]
@@ -186,24 +196,25 @@ class MapTarget:
         frequency = np.meshgrid(*(np.fft.fftfreq(n, self.spacing) for n in shape[:2]),
                                 np.fft.rfftfreq(shape[2], self.spacing), indexing="ij")
         squared = sum(f**2 for f in frequency)
-        width = ATOM_SIGMA**2 + max(self.sigma**2 - gaussian_sigma(self.cut) ** 2, 0.0)
+        width = max(ATOM_SIGMA**2 + max(self.sigma**2 - gaussian_sigma(self.cut) ** 2, 0.0)
+                    - SPREAD_VARIANCE * self.spacing**2, 0.0)
         return np.where(squared <= 1.0 / self.cut**2, np.exp(-2.0 * np.pi**2 * squared * width), 0.0)
 
-    def _corners(self, coords: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """For the 8 grid corners around every atom: the flat index of the corner (8, n),
-        whether it lies on the grid (8, n), the trilinear weight (8, n) and its derivative
-        with respect to the atom's grid coordinates (8, n, 3)."""
+    def _stencil(self, coords: np.ndarray) -> tuple[np.ndarray, np.ndarray, tuple, tuple]:
+        """For the 4×4×4 grid points around every atom: their flat indices (n, 64), whether
+        they lie on the grid (n, 64), and the cubic B-spline weights (3 of (n, 4), one per
+        axis; a point's weight is their product) and their derivatives with respect to the
+        atom's grid coordinates (likewise)."""
         index = (coords - self.origin) / self.spacing
-        base = np.floor(index).astype(int)
-        frac = index - base
-        factors = np.where(_CORNERS[:, None], frac, 1.0 - frac)  # (8, n, 3)
-        sign = np.where(_CORNERS, 1.0, -1.0)[:, None]
-        x, y, z = factors[..., 0], factors[..., 1], factors[..., 2]
-        slopes = np.stack([sign[..., 0] * y * z, x * sign[..., 1] * z, x * y * sign[..., 2]], axis=-1)
-        at = base + _CORNERS[:, None]
+        base = np.floor(index).astype(int) - 1
+        t = index - base - 1
+        weights = np.stack([(1 - t) ** 3, 3 * t**3 - 6 * t**2 + 4, -3 * t**3 + 3 * t**2 + 3 * t + 1, t**3], axis=-1) / 6
+        slopes = np.stack([-((1 - t) ** 2), 3 * t**2 - 4 * t, -3 * t**2 + 2 * t + 1, t**2], axis=-1) / 2
+        at = base[:, None, :] + _STENCIL[None]  # (n, 64, 3)
         keep = np.all((at >= 0) & (at < self.shape), axis=2)
         flat = np.where(keep, (at[..., 0] * self.shape[1] + at[..., 1]) * self.shape[2] + at[..., 2], 0)
-        return flat, keep, x * y * z, slopes
+        return (flat, keep, tuple(weights[:, axis] for axis in range(3)),
+                tuple(slopes[:, axis] for axis in range(3)))
 
 
 def _norm(grid: np.ndarray) -> float:
@@ -211,8 +222,8 @@ def _norm(grid: np.ndarray) -> float:
     return float(np.sqrt(np.sum(grid * grid)))
 
 
-_CORNERS = np.array(list(np.ndindex(2, 2, 2)))
-"""The 8 corners of a grid cell, (8, 3) of 0 or 1."""
+_STENCIL = np.array(list(np.ndindex(4, 4, 4)))
+"""The offsets of the 4×4×4 grid points an atom is spread over from the lowest, (64, 3)."""
 
 
 def heavy_atoms(model: EditableModel) -> np.ndarray:

@@ -12,7 +12,7 @@ from core.fitting.density import atom_correlation, fit_map, refine
 from core.fitting.map_target import MapTarget, gaussian_sigma, heavy_atoms
 from core.fitting.real_space import ResidueBodies, refine_real_space
 from core.fitting.side_chains import side_chain_rotors
-from core.fitting.simulated_maps import xray_like
+from core.fitting.simulated_maps import molmap, xray_like
 from core.geometry.topology import topology
 from core.geometry.validation import validate
 from core.protein.model import EditableModel
@@ -118,6 +118,26 @@ def test_the_gradient_is_the_derivative_of_the_correlation(adk: EditableModel) -
         numeric = (correlation(rotors.turned(adk.coords, angles + step))[0]
                    - correlation(rotors.turned(adk.coords, angles - step))[0]) / 2e-4
         assert numeric == pytest.approx(gradient[k], rel=0.1)
+
+
+@pytest.mark.parametrize("cut", [False, True])
+def test_the_correlation_is_smooth_as_atoms_cross_the_grid(adk: EditableModel, cut: bool) -> None:
+    """An atom moved in small steps across several grid planes: its gradient changes a
+    little each step, never jumps (spread trilinearly, it jumped at every plane, where
+    L-BFGS ends up wherever the last bits of its start lead it)."""
+    structure = read_structure(DATA / "1AKE_adk_closed.pdb.gz")
+    density = xray_like(structure, 10.0) if cut else molmap(structure, 6.0)
+    target = MapTarget(density, 10.0 if cut else 6.0, adk.coords[heavy_atoms(adk)])
+    correlation = atom_correlation(adk, target)
+    for atom in heavy_atoms(adk)[::600]:
+        coords = adk.coords.copy()
+        path = coords[atom] + np.linspace(0.0, 3.0 * target.spacing, 151)[:, None] * np.array([1.0, 0.7, 0.4])
+        gradients = []
+        for point in path:
+            coords[atom] = point
+            gradients.append(correlation(coords)[1][atom])
+        change = np.linalg.norm(np.diff(gradients, axis=0), axis=1)
+        assert change.max() < 3.0 * np.median(change) + 1e-12
 
 
 def test_the_real_space_gradient_is_the_derivative_of_what_it_climbs(adk: EditableModel) -> None:
