@@ -12,7 +12,7 @@ from core.fitting.coarse_to_fine import LevelFit
 from core.geometry.regularize import LOOSE_TO_TIGHT, TIGHT, regularized
 from core.geometry.validation import validate
 from core.protein.model import Edit, EditableModel, per_segment
-from core.protein.structure import Structure, ca_rows
+from core.protein.structure import Structure
 
 
 @dataclass(frozen=True, eq=False)
@@ -49,11 +49,9 @@ junction more put adenylate kinase 2.9 Å from its target in a 10 Å map cut sha
 Fourier space, where keeping it ends 1.4–1.5 Å from it from every start."""
 MIN_MARGIN = 2
 SCHEDULES = (LOOSE_TO_TIGHT, TIGHT)
-"""How a fit is regularized (:func:`core.geometry.regularize.relax`): loose to tight and
-tight at once, each from the fitted model; the one that leaves fewer :data:`BACKBONE` flags
-is kept, of two as good the one that moves the Cα less. (Loose to tight where it was within
-the margin: 3PTB fitted onto 3SGB ended 2.99 Å from it, Cα moved up to 60 Å, nine flags;
-tight, 1.92 Å and four.)"""
+"""How a fit is regularized (:func:`core.geometry.regularize.relax`): loose to tight, and
+tight at once where that leaves clearly more :data:`BACKBONE` flags than the input, before a
+level is undone."""
 FIT_ITERATIONS = 60
 """Levenberg–Marquardt steps at most when regularizing a fit: a whole chain moved onto
 another conformation, every side chain checked for clashes, takes 40–45 to settle, where
@@ -63,8 +61,8 @@ a drag takes 4–14 (:data:`core.geometry.least_squares.MAX_ITERATIONS`)."""
 def settle(model: EditableModel, fits: list[LevelFit], *, regularize: bool = True,
            cancelled: Callable[[], bool] = lambda: False,
            undo: Callable[[LevelFit], None] | None = None) -> FitResult:
-    """With ``regularize``, regularize what ``fits`` (applied to ``model``) moved (by the
-    best of :data:`SCHEDULES`); while the regularized model has clearly more bad peptide
+    """With ``regularize``, regularize what ``fits`` (applied to ``model``) moved (each of
+    :data:`SCHEDULES` in turn); while the regularized model has clearly more bad peptide
     junctions and Ramachandran outliers than the input (:data:`BACKBONE`, by more than
     :data:`MARGIN` of the fitted residues), undo the finest level kept (with ``undo``,
     where its edits are undo steps; else by reverting them) and try again, while more than
@@ -76,22 +74,13 @@ def settle(model: EditableModel, fits: list[LevelFit], *, regularize: bool = Tru
     allowed = (_backbone_flags(model.structure, model.structure.coords)
                + max(MIN_MARGIN, round(MARGIN * fitted)))
     dropped: list[int] = []
-    ca = ca_rows(model.structure)
     while True:
-        fitted, tried = model.coords[ca], []
-        for schedule in SCHEDULES:  # each from the fitted model
+        for schedule in SCHEDULES:
             edits = regularize_fit(model, fits, schedule)
-            tried.append((_backbone_flags(model.structure, model.coords),
-                          float(np.sum((model.coords[ca] - fitted) ** 2)), edits))
+            if sum(1 for fit in fits if fit.edits) <= 1 or _backbone_flags(model.structure, model.coords) <= allowed or cancelled():
+                return FitResult(fits, edits, dropped)
             for edit in reversed(edits):
                 model.revert(edit)
-            if cancelled():
-                break
-        flags, _, edits = min(tried, key=lambda t: t[:2])  # the fewest flags, then the Cα least moved
-        if flags <= allowed or sum(1 for fit in fits if fit.edits) <= 1 or cancelled():
-            for edit in edits:
-                model.apply(edit)
-            return FitResult(fits, edits, dropped)
         if undo is None:
             for edit in reversed(fits[-1].edits):
                 model.revert(edit)

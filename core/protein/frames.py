@@ -8,27 +8,20 @@ parameter (mathematics document, section 10.4). After an edit every atom ``x`` o
 
 Frenet normals are undefined on straight pieces and flip sign at inflections, so frames
 are made continuous: along the chain each binormal keeps the sign of its predecessor,
-residues where the curve hardly turns take the normal of their neighbours where it does
-(the nearer the more), and frames of an edited curve are oriented like those of the same
-residues before. Between turning enough and not the two are blended, so a curve moved a
-little never turns a residue a lot. (Switched at one threshold, the frame of a residue
-whose curve crossed it turned 20-75° for a 0.005 Å move, and adenylate kinase fitted into
-a map from starts 0.001 Å apart had one residue's frame 35° apart, which the regularization
-that followed made two closures of its loop, 3 Å apart.)
+residues where the curve hardly turns take the normal of the nearest residue where it
+does, and frames of an edited curve are oriented like those of the same residues before.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import solve_banded
 
 from core.curves.splines import SplineSpace
 
 MIN_TURN = 0.05
 """Frenet normals are used where the tangent turns by more than this (radians) per curve
 segment (``|f' x f''| / |f'|^2 / 2**J``): about 1 in helices, 0.1-0.6 in strands and
-loops, 0 on straight pieces and at inflections, where the normal is unstable. Below half of
-it the neighbours' normals are used, in between a blend of both."""
+loops, 0 on straight pieces and at inflections, where the normal is unstable."""
 
 
 def residue_frames(
@@ -36,13 +29,9 @@ def residue_frames(
 ) -> np.ndarray:
     """Rotation matrices ``[T N B]`` (columns) of the curve at the parameters ``u``.
 
-    Where the curve turns less than :data:`MIN_TURN` the normal is a hint from the residues
-    around that turn more, each weighted by how clearly (from ``MIN_TURN`` to twice that)
-    and halved with every residue between, made perpendicular to the tangent, and turned
-    towards the line of the residue's own Frenet normal as far as the residue turns (from
-    ``MIN_TURN / 2`` to ``MIN_TURN``); so a rigid motion of the curve moves every frame by the
-    same motion, and the frames change continuously with ``points`` (but where a binormal
-    turns 90° from its reference's).
+    Where the curve turns too little (:data:`MIN_TURN`) the normal is that of the nearest
+    residue with a usable Frenet frame, made perpendicular to the tangent; so a rigid
+    motion of the curve moves every frame by the same motion.
 
     Parameters
     ----------
@@ -61,29 +50,20 @@ def residue_frames(
     tangent = d1 / np.linalg.norm(d1, axis=1, keepdims=True)
     binormal = np.cross(d1, d2)
     strength = np.linalg.norm(binormal, axis=1)
-    turn = strength / (space.n_segments * np.einsum("ij,ij->i", d1, d1))
-    own = _smoothstep(2.0 * turn / MIN_TURN - 1.0)  # the Frenet normal's share in the frame
-    share = _smoothstep(turn / MIN_TURN - 1.0)  # and in the neighbours' hints
-    if not share.any():
-        share = own
-    defined = own > 0
+    defined = strength > MIN_TURN * space.n_segments * np.einsum("ij,ij->i", d1, d1)
     binormal[defined] /= strength[defined, None]
     binormal[~defined] = 0.0
-    chained = share > 0
     if reference is None:
-        binormal = _continuous_along_chain(binormal, chained)
+        binormal = _continuous_along_chain(binormal, defined)
     else:
         binormal *= np.where(np.einsum("ij,ij->i", binormal, reference[:, :, 2]) < 0, -1.0, 1.0)[:, None]
     normal = np.cross(binormal, tangent)
-    weak = ~chained
-    if weak.any():
-        hint = _neighbours(share[:, None] * normal) if chained.any() else (
+    if not defined.all():
+        hint = normal[_nearest_defined(defined)] if defined.any() else (
             reference[:, :, 1] if reference is not None else np.zeros_like(normal)
         )
-        hint = _perpendicular(hint[weak], tangent[weak])
-        along = np.einsum("ij,ij->i", normal[weak], hint)[:, None] * normal[weak]  # the hint on the Frenet normal's line
-        normal[weak] = own[weak, None] * along + (1.0 - own[weak, None]) * hint
-    normal = _perpendicular(normal, tangent)
+        normal[~defined] = _perpendicular(hint[~defined], tangent[~defined])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
     return np.stack([tangent, normal, np.cross(tangent, normal)], axis=2)
 
 
@@ -124,25 +104,16 @@ def _continuous_along_chain(binormal: np.ndarray, defined: np.ndarray) -> np.nda
     return binormal * signs[:, None]
 
 
-def _smoothstep(x: np.ndarray) -> np.ndarray:
-    """0 below 0, 1 above 1, and ``3x² - 2x³`` (smooth at both ends) between."""
-    x = np.clip(x, 0.0, 1.0)
-    return x * x * (3.0 - 2.0 * x)
-
-
-def _neighbours(values: np.ndarray) -> np.ndarray:
-    """For every row of ``values`` (N, 3) the sum of the others, each halved with every row
-    between (``Σ_{j≠i} 2^-|i-j| values_j``), by two bidiagonal solves; each sum scaled to its
-    largest component, so that sums of far, small terms keep their direction."""
-    bands = np.zeros((2, len(values)))
-    bands[0], bands[1, :-1] = 1.0, -0.5
-
-    def halved(x: np.ndarray) -> np.ndarray:  # y_i = (y_{i-1} + x_{i-1}) / 2, y_0 = 0
-        return solve_banded((1, 0), bands, np.vstack([np.zeros((1, 3)), 0.5 * x[:-1]]))
-
-    total = halved(values) + halved(values[::-1])[::-1]
-    scale = np.abs(total).max(axis=1, keepdims=True)
-    return np.divide(total, scale, out=np.zeros_like(total), where=scale > 0)
+def _nearest_defined(defined: np.ndarray) -> np.ndarray:
+    """For every residue the index of the nearest residue with a defined frame (itself if defined)."""
+    here = np.arange(len(defined))
+    index = np.flatnonzero(defined)
+    if len(index) == 0:
+        return here
+    position = np.searchsorted(index, here)
+    before = index[np.maximum(position - 1, 0)]
+    after = index[np.minimum(position, len(index) - 1)]
+    return np.where(here - before <= after - here, before, after)
 
 
 def _perpendicular(hint: np.ndarray, tangent: np.ndarray) -> np.ndarray:

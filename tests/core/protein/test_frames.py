@@ -4,11 +4,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.ndimage import gaussian_filter1d
 from scipy.spatial.transform import Rotation
 
 from core.curves.splines import spline_space
-from core.protein.frames import MIN_TURN, remap_atoms, residue_frames
+from core.protein.frames import remap_atoms, residue_frames
 from core.protein.reading import read_structure
 from core.protein.ribbon import build_ribbon
 
@@ -100,33 +99,3 @@ def test_a_rigid_motion_of_the_curve_moves_atoms_by_the_same_motion(ribbon_and_s
         ribbon.space.evaluate(moved_points, u), after,
     )
     assert np.abs(moved - (atoms @ rotation.T + shift)).max() < 1e-9
-
-
-@pytest.mark.parametrize("name", ["1AKE_adk_closed.pdb.gz", "1UBQ.pdb.gz", "1TIM.pdb.gz"])
-def test_frames_turn_continuously_as_the_curve_moves(name):
-    # the curve bent smoothly by 1 Å (rms) in 200 steps, from several directions: residues
-    # start and stop turning enough for their own Frenet normal (MIN_TURN) on the way, and
-    # no frame may jump (switched at the threshold, some turned 20-75 degrees in one step)
-    segment = read_structure(DATA / name).segments[0]
-    ribbon = build_ribbon("peptide", segment.ca, n_start=segment.n[0], c_end=segment.c[-1])
-    space, u = ribbon.space, ribbon.residue_u
-
-    def turning(points):
-        d1, d2 = space.evaluate(points, u, 1), space.evaluate(points, u, 2)
-        return np.linalg.norm(np.cross(d1, d2), axis=1) / (space.n_segments * np.einsum("ij,ij->i", d1, d1))
-
-    start = residue_frames(space, ribbon.points, u)
-    crossed = 0
-    for seed in range(8):
-        bend = gaussian_filter1d(np.random.default_rng(seed).normal(size=ribbon.points.shape), 3.0, axis=0)
-        bend /= np.sqrt(np.mean(np.sum(bend**2, axis=1)))
-        previous = start
-        for amount in np.linspace(0.0, 1.0, 201)[1:]:
-            frames = residue_frames(space, ribbon.points + amount * bend, u, reference=start)
-            step = Rotation.from_matrix(np.einsum("rij,rkj->rik", frames, previous)).magnitude()
-            assert np.degrees(step.max()) < 3.0, (seed, amount, step.argmax())
-            previous = frames
-        for threshold in (MIN_TURN / 2, MIN_TURN):
-            crossed += np.sum((turning(ribbon.points) > threshold) != (turning(ribbon.points + bend) > threshold))
-    assert crossed >= 2  # residues did cross the threshold
-
