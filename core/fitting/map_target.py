@@ -131,12 +131,7 @@ class MapTarget:
     def density(self, coords: np.ndarray, occupancy: np.ndarray | None = None) -> np.ndarray:
         """The model's density on the grid for atoms at ``coords`` (n, 3), each weighted by
         its ``occupancy`` (n,; default 1), as a map shows a partly occupied atom."""
-        flat, keep, weights, _ = self._stencil(coords)
-        weight = np.einsum("na,nb,nc->nabc", *weights).reshape(len(coords), -1)
-        if occupancy is not None:
-            weight = weight * occupancy[:, None]
-        spread = np.bincount(flat[keep], weight[keep], int(np.prod(self.shape)))
-        return self._blur(spread.reshape(self.shape).astype(np.float64))  # integers when no atom is on the grid
+        return self._spread(self._stencil(coords), occupancy)
 
     def correlation(self, coords: np.ndarray, occupancy: np.ndarray | None = None) -> float:
         """CC about the mean of the model's density (:meth:`density`) with the map."""
@@ -155,19 +150,32 @@ class MapTarget:
         blurred ∂CC/∂density at each atom, smooth as the CC is (spread trilinearly, the CC
         was kinked at every grid plane, and L-BFGS ended wherever the last bits of the start
         led it among the kinks)."""
-        model = self.density(coords, occupancy)
+        stencil = self._stencil(coords)
+        model = self._spread(stencil, occupancy)
         model -= model.mean()
         norm = _norm(model)
         if norm == 0.0:
             return 0.0, np.zeros_like(coords)
         cc = float(np.sum(model * self._target) / (norm * self._target_norm))
         field = self._blur(self._target / (norm * self._target_norm) - cc * model / norm**2).ravel()
-        flat, keep, (x, y, z), (dx, dy, dz) = self._stencil(coords)
-        around = np.where(keep, field[flat], 0.0).reshape(len(coords), 4, 4, 4)
-        gradient = np.stack([np.einsum("nabc,na,nb,nc->n", around, dx, y, z),
-                             np.einsum("nabc,na,nb,nc->n", around, x, dy, z),
-                             np.einsum("nabc,na,nb,nc->n", around, x, y, dz)], axis=1) / self.spacing
+        flat, keep, (x, y, z), (dx, dy, dz) = stencil
+        n = len(coords)
+        around = np.where(keep, field[flat], 0.0).reshape(n, 16, 4)
+        along_z = (around @ np.stack([z, dz], axis=2)).reshape(n, 4, 4, 2)  # [atom, a, b, (z, dz)]
+        along_yz = np.einsum("nabk,nbj->najk", along_z, np.stack([y, dy], axis=2))  # [atom, a, (y, dy), (z, dz)]
+        gradient = np.stack([np.einsum("na,na->n", dx, along_yz[:, :, 0, 0]),
+                             np.einsum("na,na->n", x, along_yz[:, :, 1, 0]),
+                             np.einsum("na,na->n", x, along_yz[:, :, 0, 1])], axis=1) / self.spacing
         return cc, gradient if occupancy is None else gradient * occupancy[:, None]
+
+    def _spread(self, stencil: tuple, occupancy: np.ndarray | None) -> np.ndarray:
+        """The model's density on the grid from its atoms' :meth:`_stencil`."""
+        flat, keep, (x, y, z), _ = stencil
+        weight = (x[:, :, None, None] * y[:, None, :, None] * z[:, None, None, :]).reshape(len(x), -1)
+        if occupancy is not None:
+            weight = weight * occupancy[:, None]
+        spread = np.bincount(flat[keep], weight[keep], int(np.prod(self.shape)))
+        return self._blur(spread.reshape(self.shape).astype(np.float64))  # integers when no atom is on the grid
 
     def _blur(self, grid: np.ndarray) -> np.ndarray:
         """The model's density from its atoms spread on the grid: blurred by a Gaussian of
@@ -210,9 +218,11 @@ class MapTarget:
         t = index - base - 1
         weights = np.stack([(1 - t) ** 3, 3 * t**3 - 6 * t**2 + 4, -3 * t**3 + 3 * t**2 + 3 * t + 1, t**3], axis=-1) / 6
         slopes = np.stack([-((1 - t) ** 2), 3 * t**2 - 4 * t, -3 * t**2 + 2 * t + 1, t**2], axis=-1) / 2
-        at = base[:, None, :] + _STENCIL[None]  # (n, 64, 3)
-        keep = np.all((at >= 0) & (at < self.shape), axis=2)
-        flat = np.where(keep, (at[..., 0] * self.shape[1] + at[..., 1]) * self.shape[2] + at[..., 2], 0)
+        at = base[:, :, None] + np.arange(4)  # (n, 3 axes, 4)
+        inside = (at >= 0) & (at < np.array(self.shape)[:, None])
+        i, j, k = at[:, 0, :, None, None], at[:, 1, None, :, None], at[:, 2, None, None, :]
+        keep = (inside[:, 0, :, None, None] & inside[:, 1, None, :, None] & inside[:, 2, None, None, :]).reshape(len(t), 64)
+        flat = np.where(keep, ((i * self.shape[1] + j) * self.shape[2] + k).reshape(len(t), 64), 0)
         return (flat, keep, tuple(weights[:, axis] for axis in range(3)),
                 tuple(slopes[:, axis] for axis in range(3)))
 
@@ -222,8 +232,6 @@ def _norm(grid: np.ndarray) -> float:
     return float(np.sqrt(np.sum(grid * grid)))
 
 
-_STENCIL = np.array(list(np.ndindex(4, 4, 4)))
-"""The offsets of the 4×4×4 grid points an atom is spread over from the lowest, (64, 3)."""
 
 
 def heavy_atoms(model: EditableModel) -> np.ndarray:
