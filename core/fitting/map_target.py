@@ -3,8 +3,9 @@
 
 The model's density is a sum of Gaussians, one per heavy atom (weighted by its occupancy),
 of width ``σ = R / (π √2)`` for a map of resolution ``R`` (as Chimera's ``molmap`` simulates
-maps), computed on an orthogonal grid by spreading the atoms trilinearly and blurring with
-:func:`scipy.ndimage.gaussian_filter`; for a map cut sharply in Fourier space (an MTZ's) the
+maps), computed on an orthogonal grid by spreading the atoms by cubic B-splines (smooth as
+they cross the grid) and blurring with :func:`scipy.ndimage.gaussian_filter` by what the
+splines leave of the width; for a map cut sharply in Fourier space (an MTZ's) the
 model's density is cut the same way. The map is resampled once onto that grid, in a box
 around the model; a crystal's map is kept only around the model.
 """
@@ -230,8 +231,6 @@ class MapTarget:
 def _norm(grid: np.ndarray) -> float:
     """The 2-norm of a grid (as a sum: BLAS's, through np.linalg.norm, is slow with its threads busy)."""
     return float(np.sqrt(np.sum(grid * grid)))
-
-
 
 
 def heavy_atoms(model: EditableModel) -> np.ndarray:
