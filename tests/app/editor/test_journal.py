@@ -200,11 +200,9 @@ for k in range(40):
     else:
         rw.move(k % 7 + 2, [1.5 * (-1) ** k, 1.0, 0.5])
     name, index = rw.history()
-    np.save(f"{out}/coords.npy.tmp.npy", rw.coords())
-    os.replace(f"{out}/coords.npy.tmp.npy", f"{out}/coords.npy")
-    with open(f"{out}/history.tmp", "w") as f:
-        json.dump([name, index, k], f)
-    os.replace(f"{out}/history.tmp", f"{out}/history.json")
+    with open(f"{out}/report.tmp", "w") as f:  # one file, replaced at once: history and coordinates agree
+        json.dump([name, index, k, rw.coords().tolist()], f)  # floats round-trip exactly through JSON
+    os.replace(f"{out}/report.tmp", f"{out}/report.json")
 """
 CHECK = """
 import json, os
@@ -235,17 +233,17 @@ def test_kill_9_at_any_moment_then_recover(tmp_path: Path, state_home: Path, aft
     with (tmp_path / "stderr.txt").open("wb") as stderr:
         child = subprocess.Popen(command, cwd=ROOT, env=env, stderr=stderr)
         deadline = time.monotonic() + 120
+        report = tmp_path / "report.json"
         while time.monotonic() < deadline and child.poll() is None:
-            progress = tmp_path / "history.json"
-            if progress.exists() and json.loads(progress.read_text())[2] >= after:
+            if report.exists() and json.loads(report.read_text())[2] >= after:
                 break
             time.sleep(0.005)
         running = child.poll() is None
         os.kill(child.pid, signal.SIGKILL)
         child.wait()
     assert running, (tmp_path / "stderr.txt").read_text()[-2000:]
-    names, index, _ = json.loads((tmp_path / "history.json").read_text())
-    reported = np.load(tmp_path / "coords.npy")
+    names, index, _, coords = json.loads(report.read_text())
+    reported = np.array(coords)
     result = subprocess.run([sys.executable, "-m", "app", "--recover", "--script", str(tmp_path / "check.py")],
                             cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr[-2000:]
