@@ -1,4 +1,4 @@
-"""Speed of remapping atoms after an edit (frames of the old and new curve + rigid-body motion).
+"""Speed of remapping atoms after an edit (each residue's rotation from the old and new curve + rigid-body motion).
 
 Usage: ``python benchmarks/bench_remap.py [STRUCTURE ...]`` (default: the test entries 1UBQ,
 1TIM and 4YVS). The longest segment is edited at level 0, so every atom of it moves; the
@@ -15,7 +15,7 @@ import numpy as np
 from timing import best_ms
 
 from core.curves.editing import move_control_point
-from core.protein.frames import remap_atoms, residue_frames
+from core.protein.frames import remap_atoms, residue_rotations
 from core.protein.model import EditableModel
 from core.protein.reading import read_structure
 from core.protein.ribbon import build_ribbon
@@ -46,10 +46,8 @@ def synthetic_chain_ms(model: EditableModel, n_atoms: int) -> tuple[int, float]:
     moved = ribbon.with_points(ribbon.points + move_control_point(2, 3, [2.0, 0.0, 1.0], ribbon.level))
 
     def remap() -> np.ndarray:
-        u = ribbon.residue_u
-        old = residue_frames(ribbon.space, ribbon.points, u)
-        new = residue_frames(moved.space, moved.points, u, reference=old)
-        return remap_atoms(coords, owners, ribbon.residue_points(), old, moved.residue_points(), new)
+        rotations = residue_rotations(ribbon.space, ribbon.points, moved.points, ribbon.residue_u)
+        return remap_atoms(coords, owners, ribbon.residue_points(), moved.residue_points(), rotations)
 
     return len(long_ca), best_ms(remap)
 

@@ -11,8 +11,8 @@ At each level the unknowns are the level's control points of every fitted segmen
 :mod:`core.fitting.coarse_to_fine`; L-BFGS maximises the CC less the energy of an elastic
 network of the Cα (which keeps the chain from molding itself into any density) and less a
 hold on how far the level moves the atoms (:data:`LEVEL_HOLD`). While it
-climbs, each residue moves with its curve point (the turn of its frame left out), so the
-objective is smooth and its gradient exact; the edits then remap the residues exactly, frames
+climbs, each residue moves with its curve point (its turn left out), so the
+objective is smooth and its gradient exact; the edits then remap the residues exactly,
 turning, where the climb ended. (Climbing the exact remap with that gradient left L-BFGS
 stopped by failed line searches wherever the mismatch caught it: adenylate kinase fitted
 from starts 0.001 Å apart ended 0.14–0.39 Å apart after level 6; climbed smooth, 0.03–0.04 Å,

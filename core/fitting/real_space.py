@@ -1,6 +1,6 @@
 """Real-space refinement into a map: every residue a rigid body with turning side chains.
 
-The levels move the residues with their curve frames; at the finest level a control
+The levels move the residues with their curve; at the finest level a control
 point still carries about three residues, and each residue keeps its place on the curve
 and its rotamer. Here, as the last step of a fit into a map, every residue of the fitted
 segments moves on its own: a shift and a rotation about its start Cα, and its side-chain

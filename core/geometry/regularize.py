@@ -1,6 +1,6 @@
 """Regularization after a multiresolution edit: ideal peptide junctions, no new clashes.
 
-Carson's edits move each residue as a rigid body with its curve frame and apply no other
+Carson's edits move each residue as a rigid body with its curve and apply no other
 constraint, so peptide bonds stretch and atoms run into each other. Here the residues an
 edit moved (plus ``flank`` neighbours on each side) are moved again, each as a rigid body
 whose carbonyl O may turn about the Cα–C bond (ψ), to the least-squares best compromise

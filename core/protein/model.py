@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from core.curves.editing import changed_segments, move_control_point, tug_curve
-from core.protein.frames import remap_atoms, residue_frames
+from core.protein.frames import remap_atoms
 from core.protein.ribbon import Ribbon, RibbonKind, segment_ribbon
 from core.protein.structure import BackboneSegment, Structure
 from core.protein.writing import write_structure
@@ -111,16 +111,13 @@ class EditableModel:
         residues = ribbon.residue_segments(moved_segments)
         rows, owner = _residue_rows(self.segments[segment], residues)
         u = ribbon.residue_u[residues]
-        old_frames = residue_frames(ribbon.space, ribbon.points, u)
-        new_frames = residue_frames(ribbon.space, new_ribbon.points, u, reference=old_frames)
         old_coords = self.coords[rows]
         new_coords = remap_atoms(
             old_coords,
             owner,
             ribbon.space.evaluate(ribbon.points, u),
-            old_frames,
             ribbon.space.evaluate(new_ribbon.points, u),
-            new_frames,
+            ribbon.residue_rotations(new_ribbon.points, residues),
         )
         return Edit(segment, ribbon.points, new_ribbon.points, residues, rows, old_coords, new_coords)
 

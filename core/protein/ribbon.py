@@ -28,6 +28,7 @@ from scipy import linalg
 from core import _validate
 from core.curves.splines import SplineSpace, spline_space
 from core.curves.wavelets import fractional_points
+from core.protein.frames import residue_rotations, stretches
 from core.protein.structure import BackboneSegment
 
 
@@ -102,13 +103,31 @@ class Ribbon:
         points, j = self.control_points(level)
         return spline_space(j).evaluate(points, self.residue_u)
 
+    @property
+    def span(self) -> tuple[float, float]:
+        """The parameters the residues' curve covers (half a segment beyond the first and last
+        residue point), without the padding."""
+        half = 0.5 / 2**self.level
+        return float(self.residue_u[0] - half), float(self.residue_u[-1] + half)
+
+    def residue_rotations(self, new_points: np.ndarray, residues: np.ndarray) -> np.ndarray:
+        """How ``residues`` turn when the finest control points become ``new_points``
+        (:func:`core.protein.frames.residue_rotations`)."""
+        return residue_rotations(self.space, self.points, new_points, self.residue_u[residues], self.span)
+
     def residue_segments(self, segments: np.ndarray) -> np.ndarray:
-        """Residues whose curve point or frame depends on the given finest segments."""
-        owner = np.floor(self.residue_u * 2**self.level).astype(np.int64)  # segment holding u_i
-        touched = np.isin(owner, segments)
+        """Residues whose curve point or rotation (:func:`core.protein.frames.stretches`)
+        depends on the given finest segments."""
+        n = 2**self.level
+        stretch = stretches(self.residue_u, self.span, n)
+        first = np.floor(np.minimum(self.residue_u, stretch[:, 0]) * n).astype(np.int64)
+        last = np.minimum(np.floor(np.maximum(self.residue_u, stretch[:, -1]) * n).astype(np.int64), n - 1)
         if self.kind is RibbonKind.CALPHA:  # residues sit on knots: both neighbours count
-            touched |= np.isin(owner - 1, segments)
-        return np.flatnonzero(touched)
+            first -= 1
+        touched = np.zeros(n + 1, dtype=np.int64)  # segments changed before each index
+        touched[np.asarray(segments, dtype=np.int64) + 1] = 1
+        touched = np.cumsum(touched)
+        return np.flatnonzero(touched[last + 1] > touched[np.maximum(first, 0)])
 
     def with_points(self, points: np.ndarray) -> Ribbon:
         """The same ribbon with new finest control points (after an edit)."""

@@ -23,8 +23,10 @@ from app.editor.main_window import MainWindow
 from app.editor.map_correlation import INTERVAL_MS, JUDGE_MS
 from app.editor.scene.map_mesh import RECONTOUR_MS
 from core.analysis.superpose import superpose
+from core.fitting import settle as settle_module
 from core.fitting.domains import DOMAINS
 from core.fitting.map_target import gaussian_sigma
+from core.fitting.settle import BACKBONE
 from core.geometry.validation import validate
 from core.protein.reading import read_structure
 from core.protein.structure import ca_rows
@@ -286,21 +288,36 @@ def test_fit_to_compared_structure_brings_the_ca_rmsd_down(open_window: Callable
     assert rmsd > 6.0 and _ca_rmsd(window, target_ca) < 1.5
 
 
-def test_coarse_to_fine_undoes_the_finest_levels_a_homologue_cannot_take(
-    open_window: Callable[[str], MainWindow]
-) -> None:
+def test_a_homologue_keeps_every_level_and_its_backbone(open_window: Callable[[str], MainWindow]) -> None:
     window = open_window("3PTB.pdb.gz")  # trypsin, onto another serine protease's backbone
     window.comparison.add(DATA / "3SGB.pdb.gz")
     document = window.document
     before = validate(document.structure).counts
     fitted = window.rw.fit_to_compared()  # levels 0 to 6
     steps, index = window.rw.history()
-    kept = [level for level, _ in fitted]
-    assert kept == list(range(len(kept))) and kept[-1] < 6  # as the command line: level 6 undone
-    assert index == len(kept) + 1 and steps[-1].startswith("Regularize the fit to 3SGB")
-    assert "6 undone" in steps[-1]
+    assert [level for level, _ in fitted] == list(range(7)) and fitted[-1][1] < 0.7 * fitted[0][1]
+    assert index == 8 and steps[-1] == "Regularize the fit to 3SGB E"  # (its chain E)
     after = validate(document.structure, document.model.coords).counts
-    assert after["peptide_bond"] + after["ca_ca"] <= before["peptide_bond"] + before["ca_ca"]
+    assert sum(after[k] for k in BACKBONE) <= sum(before[k] for k in BACKBONE)
+
+
+def test_coarse_to_fine_undoes_the_finest_levels_the_backbone_cannot_take(
+    open_window: Callable[[str], MainWindow], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Allowed fewer flags than any model has, the fit undoes its levels down to the coarsest
+    one, each undone level's step off the undo stack, and says so in History."""
+    monkeypatch.setattr(settle_module, "MIN_MARGIN", -1000)
+    monkeypatch.setattr(settle_module, "MARGIN", -1.0)
+    window = open_window("3PTB.pdb.gz")
+    window.comparison.add(DATA / "3SGB.pdb.gz")
+    structure = window.document.structure
+    fitted = window.rw.fit_to_compared([0, 1, 2])
+    steps, index = window.rw.history()
+    assert [level for level, _ in fitted] == [0]
+    assert index == 2 and steps[-1].startswith("Regularize the fit to 3SGB") and "level 1, 2 undone" in steps[-1]
+    window.rw.undo()
+    window.rw.undo()
+    assert np.array_equal(window.document.model.coords, structure.coords)
 
 
 def test_fits_need_a_target(open_window: Callable[[str], MainWindow], errors: list[str]) -> None:
