@@ -9,8 +9,9 @@ The domains are those of the Gaussian network model (GNM) of the chain's Cα (Ba
 1997): the sign of the slowest mode splits the chain in two, smoothed along the sequence so
 that it crosses between them only at hinges (:func:`dynamic_domains`). The smaller one is
 fitted as a rigid body (rotation about its centroid and translation) into the map blurred
-to :data:`RESOLUTION`, by L-BFGS on the correlation from :data:`TURNS` starts, and kept
-where it gains :data:`GAIN` of correlation. In the wavelet framework the motion is an edit
+to :data:`RESOLUTION`, by L-BFGS on the correlation from :data:`TURNS` starts, the chain
+held together where it crosses between the domains (:data:`HINGE_WEIGHT`), and kept where it
+gains :data:`GAIN` of correlation. In the wavelet framework the motion is an edit
 at the finest level: each finest control point whose nearest residue lies in the domain
 moves with it, and the residues follow the curve (those inside the domain
 rigidly, exactly, those at its hinges bent), as when a control point is dragged.

@@ -28,7 +28,7 @@ from scipy import linalg
 from core import _validate
 from core.curves.splines import SplineSpace, spline_space
 from core.curves.wavelets import fractional_points
-from core.protein.frames import residue_rotations, stretches
+from core.protein.frames import PER_SEGMENT, residue_rotations, stretches
 from core.protein.structure import BackboneSegment
 
 
@@ -119,7 +119,7 @@ class Ribbon:
         """Residues whose curve point or rotation (:func:`core.protein.frames.stretches`)
         depends on the given finest segments."""
         n = 2**self.level
-        stretch = stretches(self.residue_u, self.span, n)
+        stretch = stretches(self.residue_u, self.span, n) / (PER_SEGMENT * n)
         first = np.floor(np.minimum(self.residue_u, stretch[:, 0]) * n).astype(np.int64)
         last = np.minimum(np.floor(np.maximum(self.residue_u, stretch[:, -1]) * n).astype(np.int64), n - 1)
         if self.kind is RibbonKind.CALPHA:  # residues sit on knots: both neighbours count
