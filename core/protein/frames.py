@@ -67,6 +67,8 @@ def residue_rotations(space: SplineSpace, old_points: np.ndarray, new_points: np
     curve's finest control points change from ``old_points`` to ``new_points``; ``span``, the
     parameters the chain's residues cover (:func:`stretches`)."""
     stretch = stretches(u, span, space.n_segments)
+    if stretch.size == 0:
+        return np.zeros((0, 3, 3))
     low, high = int(stretch.min()), int(stretch.max())
     grid = np.arange(low, high + 1) / (PER_SEGMENT * space.n_segments)
     before = space.evaluate(old_points, grid)  # each grid point once, then summed over each stretch

@@ -13,6 +13,7 @@ import pytest
 
 from app.main import main
 from core.protein.reading import read_structure
+from core.protein.structure import ca_rows
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 AWKWARD = ["1L2Y.pdb.gz", "2BEG.pdb.gz", "1LCD.cif.gz", "3JQH.cif.gz", "1EJG.pdb.gz", "1ORC.pdb.gz",
@@ -99,15 +100,20 @@ def test_zero_edit_reproduces_every_awkward_entry(capsys, tmp_path, name):
     assert np.allclose(read_structure(out).coords, structure.coords, atol=5e-4)
 
 
-def test_edit_at_the_finest_level_moves_four_residues(capsys, tmp_path):
+def test_edit_at_the_finest_level_moves_four_residues_and_turns_their_neighbours(capsys, tmp_path):
+    """A finest control point carries the curve points of four residues; the three on each
+    side turn with the curve around them, about their own curve points."""
     out = tmp_path / "edited.pdb"
     status, printed, _ = run(capsys, "edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "6.25",
                              "--point", "65", "--move", "2,0,-1", "-o", out)
-    assert status == 0 and "moved 4 residues" in printed
+    assert status == 0 and "moved 10 residues" in printed
     before, after = read_structure(DATA / "1UBQ.pdb.gz"), read_structure(out)
     moved = np.flatnonzero(np.linalg.norm(after.coords - before.coords, axis=1) > 1e-3)
     residues = np.unique(before.atom_residue[moved])
-    assert len(residues) == 4 and np.all(np.diff(residues) == 1)
+    assert len(residues) == 10 and np.all(np.diff(residues) == 1)
+    ca = ca_rows(before)[residues]
+    shift = np.linalg.norm(after.coords[ca] - before.coords[ca], axis=1)
+    assert shift.argmax() in (4, 5) and shift[4:6].min() > 5.0 * shift[[0, 1, 2, 7, 8, 9]].max()
 
 
 def test_edit_of_a_residue_curve_point(capsys, tmp_path):
@@ -161,7 +167,7 @@ def test_negative_displacements_need_no_equals_sign(capsys, tmp_path):
     out = tmp_path / "left.pdb"
     status, printed, _ = run(capsys, "edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "4",
                              "--point", "8", "--move", "-3,4,-0.5", "-o", out)
-    assert status == 0 and "moved 32 residues" in printed
+    assert status == 0 and "moved 38 residues" in printed
 
 
 def test_usage_errors_exit_2(capsys):

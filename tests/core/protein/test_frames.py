@@ -34,6 +34,7 @@ def test_rotations_are_rotations_and_none_where_the_curve_stays(ribbon_and_segme
     assert _angles(rotations).max() > 5.0  # they do turn
     unchanged = ribbon.residue_rotations(ribbon.points.copy(), np.arange(len(ribbon.residue_u)))
     assert np.allclose(unchanged, np.eye(3), atol=1e-12)
+    assert ribbon.residue_rotations(new_points, np.zeros(0, dtype=int)).shape == (0, 3, 3)
 
 
 @pytest.mark.parametrize("seed", range(4))
