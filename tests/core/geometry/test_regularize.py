@@ -134,7 +134,7 @@ def test_residues_keep_their_geometry_and_turn_only_about_two_bonds(ubiquitin):
     every bond length and angle of the residue stays as it was. This inward edit still
     clashes once the backbone alone has settled, so side chains turn too."""
     model = EditableModel(ubiquitin)
-    edit = outward_edit(model, 5, 9, distance=-5.0)
+    edit = outward_edit(model, 5, 9, distance=-9.0)  # (5 Å in: the backbone alone settles it)
     edited = coords_after(model, edit)
     fixed = regularized(model, edit)
     after = coords_after(model, fixed)

@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from core.protein.frames import REACH
 from core.protein.model import EditableModel
 from core.protein.reading import read_structure
 
@@ -30,9 +31,11 @@ def moved_residues(model, edit):
 
 
 def test_locality_on_ubiquitin_doubles_per_level(model):
-    """Carson's ubiquitin experiment: 4 residues move at full resolution, 8, 16, 32 below."""
+    """Carson's ubiquitin experiment: the curve points of 4 residues move at full resolution,
+    8, 16, 32 below; each residue turns with the curve within REACH residues of it, so as
+    many more on each side move (turned about their curve points)."""
     ribbon = model.ribbons[0]
-    counts = []
+    carried, counts = [], []
     for level in (ribbon.max_level, 6, 5, 4):
         points, _ = ribbon.control_points(level)
         edit = model.move_point(0, level, len(points) // 2, [1.5, -1.0, 2.0])
@@ -40,7 +43,10 @@ def test_locality_on_ubiquitin_doubles_per_level(model):
         assert np.array_equal(residues, edit.residues)
         assert np.all(np.diff(residues) == 1)  # one contiguous stretch
         counts.append(len(residues))
-    assert counts == [4, 8, 16, 32]
+        shift = ribbon.space.evaluate(edit.new_points, ribbon.residue_u) - ribbon.residue_points()
+        carried.append(int(np.count_nonzero(np.linalg.norm(shift, axis=1) > 1e-9)))
+    assert carried == [4, 8, 16, 32]
+    assert counts == [n + 2 * REACH for n in carried]
 
 
 def test_unaffected_atoms_are_bit_identical(model, ubiquitin):
