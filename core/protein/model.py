@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from core.curves.editing import changed_segments, move_control_point, tug_curve
+from core.curves.editing import move_control_point, tug_curve
 from core.protein.frames import remap_atoms
 from core.protein.ribbon import Ribbon, RibbonKind, segment_ribbon
 from core.protein.structure import BackboneSegment, Structure
@@ -107,8 +107,7 @@ class EditableModel:
         """The edit that gives segment ``segment`` the finest control points ``new_points``."""
         ribbon = self._ribbon(segment)
         new_ribbon = ribbon.with_points(new_points)
-        moved_segments = changed_segments(new_ribbon.points - ribbon.points, tolerance=NEGLIGIBLE_MOVE)
-        residues = ribbon.residue_segments(moved_segments)
+        residues = ribbon.residues_moved_by(np.abs(new_ribbon.points - ribbon.points).max(axis=1) > NEGLIGIBLE_MOVE)
         rows, owner = _residue_rows(self.segments[segment], residues)
         u = ribbon.residue_u[residues]
         old_coords = self.coords[rows]

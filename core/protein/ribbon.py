@@ -115,19 +115,18 @@ class Ribbon:
         (:func:`core.protein.frames.residue_rotations`)."""
         return residue_rotations(self.space, self.points, new_points, self.residue_u[residues], self.span)
 
-    def residue_segments(self, segments: np.ndarray) -> np.ndarray:
+    def residues_moved_by(self, moved: np.ndarray) -> np.ndarray:
         """Residues whose curve point or rotation (:func:`core.protein.frames.stretches`)
-        depends on the given finest segments."""
-        n = 2**self.level
-        stretch = stretches(self.residue_u, self.span, n) / (PER_SEGMENT * n)
-        first = np.floor(np.minimum(self.residue_u, stretch[:, 0]) * n).astype(np.int64)
-        last = np.minimum(np.floor(np.maximum(self.residue_u, stretch[:, -1]) * n).astype(np.int64), n - 1)
-        if self.kind is RibbonKind.CALPHA:  # residues sit on knots: both neighbours count
-            first -= 1
-        touched = np.zeros(n + 1, dtype=np.int64)  # segments changed before each index
-        touched[np.asarray(segments, dtype=np.int64) + 1] = 1
-        touched = np.cumsum(touched)
-        return np.flatnonzero(touched[last + 1] > touched[np.maximum(first, 0)])
+        depends on the finest control points flagged in ``moved`` ((n_points,) bool)."""
+        per = PER_SEGMENT * 2**self.level
+        stretch = stretches(self.residue_u, self.span, 2**self.level)
+        own = np.rint(self.residue_u * per).astype(np.int64)  # the residue point, on the same grid
+        low, high = np.minimum(stretch[:, 0], own), np.maximum(stretch[:, -1], own)
+        # a curve point inside segment s depends on rows s..s+3, one on the knot s on rows s..s+2
+        first = low // PER_SEGMENT
+        last = np.minimum(high // PER_SEGMENT + np.where(high % PER_SEGMENT == 0, 2, 3), len(moved) - 1)
+        count = np.concatenate([[0], np.cumsum(moved)])
+        return np.flatnonzero(count[last + 1] > count[first])
 
     def with_points(self, points: np.ndarray) -> Ribbon:
         """The same ribbon with new finest control points (after an edit)."""

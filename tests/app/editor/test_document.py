@@ -91,7 +91,7 @@ def test_picking_tells_which_residues_a_point_moves(ubiquitin: Document, qtbot: 
     ubiquitin.set_level(ubiquitin.max_level)
     with qtbot.waitSignal(ubiquitin.picked):
         ubiquitin.pick_point(40)
-    assert len(ubiquitin.pick.residues) == 4  # Carson: four residues at full resolution
+    assert len(ubiquitin.pick.residues) == 10  # Carson's four at full resolution, three turned on each side
     ubiquitin.set_level(3.0)
     assert ubiquitin.pick is None  # a new level shows other control points
     ubiquitin.pick_point(5)

@@ -198,7 +198,7 @@ def test_layers_colours_and_fat_helices(window: MainWindow) -> None:
 # ------------------------------------------------------------------ editing with the mouse
 
 
-@pytest.mark.parametrize(("level", "expected"), [("max", 4), (5.0, 16), (4.0, 32)])
+@pytest.mark.parametrize(("level", "expected"), [("max", 10), (5.0, 22), (4.0, 38)])
 def test_dragging_a_control_point_edits_the_structure(
     window: MainWindow, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, level: object, expected: int
 ) -> None:
@@ -213,7 +213,8 @@ def test_dragging_a_control_point_edits_the_structure(
     assert document.undo_stack.count() == 1  # one drag, one undo step
     assert document.undo_stack.text(0) == f"Move point {index} at level {document.shown_level():.2f}"
     moved = _moved_residues(document, original)
-    assert len(moved) == expected  # 4 residues at full resolution, twice as many one level down (J = 7 here)
+    assert len(moved) == expected  # the curve points of 4 residues at full resolution, twice as many one level
+    # down (J = 7 here), and 3 more on each side turned with the curve
     assert np.array_equal(moved, document.structure.segments[0].residue_index[document.pick.residues])
     owned = np.isin(document.structure.atom_residue, moved)
     assert np.array_equal(document.model.coords[~owned], original[~owned])  # all other atoms bit-identical
