@@ -3,8 +3,8 @@
 At level j the unknowns are the level-j control points of each fitted segment. A change
 ``ΔC^j`` reaches the finest control points as ``M_j ΔC^j`` with ``M_j = P^J ⋯ P^{j+1}``
 (every finer detail kept, Carson eq. 5) and moves residue point ``C^r_i = Φ(u_i) C`` by
-``Φ(u_i) M_j ΔC^j``; the residues follow as rigid bodies, turning with the curve around them, exactly as
-when a control point is dragged (:meth:`~core.protein.model.EditableModel.plan`).
+``Φ(u_i) M_j ΔC^j``; the residues follow as rigid bodies, turning with the curve around
+them, exactly as when a control point is dragged (:meth:`~core.protein.model.EditableModel.plan`).
 
 Against paired target Cα the step at a level is linear least squares: with each residue's
 Cα held at its offset from its curve point (the residues' turn left out), find the
