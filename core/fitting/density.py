@@ -4,8 +4,9 @@ The model's density is a sum of Gaussians, one per heavy atom, of width
 ``σ = R / (π √2)`` for a map of resolution ``R`` (as Chimera's ``molmap`` simulates maps),
 computed on an orthogonal grid by spreading the atoms by cubic B-splines and blurring with
 :func:`scipy.ndimage.gaussian_filter` (:mod:`core.fitting.map_target`). The map is
-resampled once onto that grid, in a box around the model. The objective is their correlation about the mean (CC), whose gradient
-with respect to every atom is the blurred derivative field interpolated at the atom.
+resampled once onto that grid, in a box around the model. The objective is their
+correlation about the mean (CC), whose gradient with respect to every atom is the blurred
+derivative field interpolated at the atom.
 
 At each level the unknowns are the level's control points of every fitted segment, as in
 :mod:`core.fitting.coarse_to_fine`; L-BFGS maximises the CC less the energy of an elastic
