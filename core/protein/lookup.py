@@ -1,39 +1,117 @@
-"""Residues named as people type them: ``A:45``, ``45``, ``A45``, ``A:LYS45``, ``A:52A``, ``A:40-50``."""
+"""Residues named as people type them: ``A:45``, ``45``, ``A45``, ``A:LYS45``, ``A:52A``,
+``A:40-50``; as ChimeraX specifies them (``/A:45-50``, ``:45``, ``#1/A:45``, ``/A``); and as
+PyMOL selects them (``chain A and resi 45-50``, ``resi 45``, ``c. A & i. 45``, ``/obj//A/45``,
+``A/45/``, ``A/LYS`45/CA``)."""
 
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
 from core.protein.structure import Structure
 
-_RESIDUE = re.compile(r"(?:(?P<chain>[A-Za-z0-9]{1,4})\s*[:/]\s*|(?P<letter>[A-Za-z])(?=-?\d))?"
-                      r"(?P<name>[A-Za-z]{3})?(?P<first>-?\d+)(?P<icode>[A-Za-z]?)"
-                      r"(?:\s*(?:-|–|\.\.)\s*(?P<last>-?\d+)(?P<last_icode>[A-Za-z]?))?")
+_NUMBERS = r"(?P<first>-?\d+)(?P<icode>[A-Za-z]?)(?:\s*(?:-|–|\.\.)\s*(?P<last>-?\d+)(?P<last_icode>[A-Za-z]?))?"
+_CHAIN = r"[A-Za-z0-9]{1,4}"
+_OWN = re.compile(rf"(?:(?P<chain>{_CHAIN})\s*[:/]\s*|(?P<letter>[A-Za-z])(?=-?\d))?(?P<name>[A-Za-z]{{3}})?{_NUMBERS}")
+_CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{_CHAIN}))?\s*(?::{_NUMBERS})?")
+_PYMOL_RESI = re.compile(rf"(?:(?P<name>[A-Za-z]{{3}})`)?{_NUMBERS}")
+_PYMOL_WORDS = {"chain": "chain", "c.": "chain", "resi": "resi", "i.": "resi", "resn": "resn", "r.": "resn"}
+HELP = ("type e.g. A:45, 45 or A:40-50; ChimeraX /A:45-50 or :45; PyMOL chain A and resi 45-50, resi 45, "
+        "/obj//A/45 or A/45/")
+
+
+@dataclass(frozen=True)
+class _Named:
+    """What a text names: a chain, a residue or a range of them, in any of the syntaxes."""
+
+    chain: str | None = None
+    first: int | None = None
+    icode: str = ""
+    last: int | None = None
+    last_icode: str = ""
+    name: str | None = None
+
+    @classmethod
+    def of(cls, match: re.Match, chain: str | None, name: str | None = None) -> _Named:
+        last = match["last"]
+        return cls(chain, None if match["first"] is None else int(match["first"]), (match["icode"] or "").upper(),
+                   None if last is None else int(last), (match["last_icode"] or "").upper(), name)
 
 
 def find_residues(structure: Structure, text: str, chain: str | None = None) -> np.ndarray:
     """Residue-table rows named by ``text``: one residue (``A:45``, ``45``, ``A45``, ``A:LYS45``,
-    ``A:52A``) or a range (``A:40-50``), in ``chain`` when the text names none (any chain
-    when ``chain`` is None, the first that has it). Raises ValueError naming what is missing."""
-    match = _RESIDUE.fullmatch(text.strip())
-    if match is None:
-        raise ValueError(f"cannot read {text!r} as a residue: type e.g. A:45, 45 or A:40-50")
-    named = match["chain"] or match["letter"]
+    ``A:52A``), a range (``A:40-50``) or a whole chain (``/A``, ``chain A``), in any syntax of
+    the module's, in ``chain`` when the text names none (any chain when ``chain`` is None, the
+    first that has it). Raises ValueError naming what is missing or how to type it."""
+    named = _read(text.strip())
+    if named is None:
+        raise ValueError(f"cannot read {text.strip()!r} as residues: {HELP}")
     chains = [s.chain for s in structure.segments]
-    if named is not None and named not in chains:
-        raise ValueError(f"no chain {named} with a protein backbone (chains: {', '.join(dict.fromkeys(chains))})")
-    wanted = named if named is not None else chain
-    first = _row(structure, wanted, int(match["first"]), match["icode"].upper(), match["name"], text)
-    if match["last"] is None:
+    if named.chain is not None and named.chain not in chains:
+        raise ValueError(f"no chain {named.chain} with a protein backbone (chains: {', '.join(dict.fromkeys(chains))})")
+    if named.first is None:  # a whole chain
+        return np.concatenate([s.residue_index for s in structure.segments if s.chain == named.chain])
+    wanted = named.chain if named.chain is not None else chain
+    first = _row(structure, wanted, named.first, named.icode, named.name, text)
+    if named.last is None:
         return np.array([first])
-    last = _row(structure, wanted if wanted is not None else _chain_of(structure, first), int(match["last"]),
-                match["last_icode"].upper(), None, text)
+    last = _row(structure, wanted if wanted is not None else _chain_of(structure, first), named.last,
+                named.last_icode, None, text)
     low, high = sorted((first, last))
     if _chain_of(structure, low) != _chain_of(structure, high):
-        raise ValueError(f"{text!r} spans two chains")
+        raise ValueError(f"{text.strip()!r} spans two chains")
     return np.arange(low, high + 1)
+
+
+def _read(text: str) -> _Named | None:
+    """``text`` read in the first syntax that reads it whole, or None."""
+    if match := _OWN.fullmatch(text):
+        return _Named.of(match, match["chain"] or match["letter"], match["name"])
+    if text.startswith(("/", "#", ":")) and (match := _CHIMERAX.fullmatch(text)) and (match["chain"] or match["first"]):
+        return _Named.of(match, match["chain"])
+    if "/" in text:
+        return _pymol_path(text)
+    return _pymol_words(text)
+
+
+def _pymol_path(text: str) -> _Named | None:
+    """PyMOL's ``/object/segment/chain/residue/atom``: from the left where it begins with a
+    slash, else from the right (``A/45/``: chain A, residue 45, any atom)."""
+    fields = [field.strip() for field in text.split("/")]
+    if text.startswith("/"):
+        chain, residue = (fields[1:] + [""] * 5)[2:4]
+    elif len(fields) >= 3:
+        chain, residue = fields[-3:-1]
+    else:
+        return None
+    if chain and not re.fullmatch(_CHAIN, chain):
+        return None
+    if not residue:
+        return _Named(chain) if chain else None
+    match = _PYMOL_RESI.fullmatch(residue)
+    return None if match is None else _Named.of(match, chain or None, match["name"])
+
+
+def _pymol_words(text: str) -> _Named | None:
+    """PyMOL's property selectors joined by ``and`` (or ``&``): ``chain A and resi 45-50``,
+    ``c. A & i. 45``, ``resn LYS and resi 45``."""
+    found: dict[str, str] = {}
+    for term in re.split(r"\s+and\s+|\s*&\s*", text.strip(), flags=re.IGNORECASE):
+        word, _, value = term.strip().partition(" ")
+        key = _PYMOL_WORDS.get(word.lower())
+        if key is None or key in found or not value.strip():
+            return None
+        found[key] = value.strip()
+    chain, name = found.get("chain"), found.get("resn")
+    if (chain is not None and not re.fullmatch(_CHAIN, chain)) or (name is not None
+                                                                   and not re.fullmatch("[A-Za-z]{3}", name)):
+        return None
+    if "resi" not in found:
+        return _Named(chain) if chain is not None and name is None else None
+    match = re.fullmatch(_NUMBERS, found["resi"])
+    return None if match is None else _Named.of(match, chain, name)
 
 
 def _row(structure: Structure, chain: str | None, number: int, icode: str, name: str | None, text: str) -> int:

@@ -29,7 +29,8 @@ class Navigation:
         self.scene = scene
         self.plotter = plotter
         self.go_to_action = menus.action("&Go to Residue…", QKeySequence("Ctrl+L"), self._focus_go_to)
-        self.go_to_action.setToolTip("Select a residue or a range and centre the view on it: A:45, 45, A:40-50")
+        self.go_to_action.setToolTip("Select residues and centre the view on them: A:45, 45, A:40-50; as in ChimeraX "
+                                      "(/A:40-50, :45, /A) or PyMOL (chain A and resi 40-50, resi 45, A/45/)")
         self.reset_view_action = menus.action("&Reset View", QKeySequence("Ctrl+R"), self._reset_view,
                                               window.style().standardIcon(QStyle.StandardPixmap.SP_BrowserReload))
         self.go_to_field = QLineEdit()
@@ -66,7 +67,8 @@ class Navigation:
 
     def go_to(self, text: str) -> np.ndarray:
         """Select and centre on the residues named by ``text`` (``A:45``, ``45`` in the edited
-        chain, ``A:40-50``); returns their residue-table rows (raises ValueError)."""
+        chain, ``A:40-50``, or as ChimeraX and PyMOL name them: :mod:`core.protein.lookup`);
+        returns their residue-table rows (raises ValueError)."""
         if self.document.model is None:
             raise ValueError("no structure is open")
         chain = self.document.structure.segments[self.document.segment].chain

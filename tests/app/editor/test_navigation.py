@@ -123,6 +123,13 @@ def test_go_to_residue_by_keyboard(window: MainWindow, qtbot: QtBot) -> None:
     assert list(window.document.selection) == list(range(29, 35))
     np.testing.assert_allclose(_focal(window), np.mean([_ca(window, r) for r in range(29, 35)], axis=0), atol=1e-6)
 
+    for typed in ("/A:30-35", "chain A and resi 30-35", "A/30-35/"):  # as ChimeraX and PyMOL users type them
+        window.document.select([])
+        qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+        qtbot.keyClicks(window.navigation.go_to_field, typed)
+        qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
+        assert list(window.document.selection) == list(range(29, 35)), typed
+
     before = _focal(window)
     qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
     qtbot.keyClicks(window.navigation.go_to_field, "A:999")

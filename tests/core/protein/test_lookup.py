@@ -30,6 +30,21 @@ def test_one_residue(haemoglobin, text: str, chain: str | None, label: str) -> N
     assert len(rows) == 1 and _label(haemoglobin, int(rows[0])) == label
 
 
+@pytest.mark.parametrize(("text", "chain", "labels"), [
+    ("/B:40-50", "A", ("B:ARG40", "B:THR50", 11)), (":45", "C", ("C:HIS45", "C:HIS45", 1)),  # ChimeraX
+    ("#1/D:45", None, ("D:PHE45", "D:PHE45", 1)), ("/C", "A", ("C:VAL1", "C:ARG141", 141)),
+    ("chain B and resi 40-50", "A", ("B:ARG40", "B:THR50", 11)), ("resi 45", "D", ("D:PHE45", "D:PHE45", 1)),  # PyMOL
+    ("resi 45 and chain C", None, ("C:HIS45", "C:HIS45", 1)), ("c. B & i. 45", None, ("B:PHE45", "B:PHE45", 1)),
+    ("RESN PHE AND RESI 45 AND CHAIN D", None, ("D:PHE45", "D:PHE45", 1)), ("chain D", "A", ("D:VAL1", "D:HIS146", 146)),
+    ("/4hhb//B/40-50/CA", None, ("B:ARG40", "B:THR50", 11)), ("A/45/", "C", ("A:HIS45", "A:HIS45", 1)),
+    ("B/PHE`45/CA", None, ("B:PHE45", "B:PHE45", 1)), ("/4hhb//C", None, ("C:VAL1", "C:ARG141", 141)),
+])
+def test_chimerax_and_pymol_forms(haemoglobin, text: str, chain: str | None, labels: tuple[str, str, int]) -> None:
+    rows = find_residues(haemoglobin, text, chain)
+    assert (_label(haemoglobin, int(rows[0])), _label(haemoglobin, int(rows[-1])), len(rows)) == labels
+    assert np.array_equal(rows, np.arange(rows[0], rows[-1] + 1))
+
+
 def test_a_range_in_either_order(haemoglobin) -> None:
     rows = find_residues(haemoglobin, "B:40-50")
     assert [_label(haemoglobin, int(r)) for r in rows[[0, -1]]] == ["B:ARG40", "B:THR50"] and len(rows) == 11
@@ -47,6 +62,9 @@ def test_insertion_codes() -> None:
 @pytest.mark.parametrize(("text", "message"), [
     ("A:999", "no residue A:999 in chain A"), ("Z:5", "no chain Z"), ("A:ALA45", "no residue A:ALA45"),
     ("hello world", "cannot read 'hello world'"), ("", "cannot read"),
+    ("resi 45+47", r"cannot read 'resi 45\+47' as residues: type e.g. A:45.*ChimeraX /A:45-50.*PyMOL chain A and resi"),
+    ("byres all", "cannot read 'byres all'"), ("chain A and chain B", "cannot read"), ("resn LYS", "cannot read"),
+    ("#1", "cannot read"), ("/Z:5", "no chain Z"), ("chain B and resi 400", "no residue chain B and resi 400 in chain B"),
 ])
 def test_clear_messages(haemoglobin, text: str, message: str) -> None:
     with pytest.raises(ValueError, match=message):
