@@ -112,7 +112,9 @@ finer (:meth:`MapTarget.blurred`, :func:`level_resolution`); the refinement fits
 map as it is."""
 RESOLUTION_PER_RESIDUE = 2.0
 """Å per residue of a span between a level's control points: the resolution that level
-sees the map at (:func:`level_resolution`; coarser levels see it coarser)."""
+sees the map at (:func:`level_resolution`; coarser levels see it coarser); control points
+spaced less than half the map's resolution apart sample it finer than it resolves
+(:func:`resolved_levels`)."""
 
 
 def atom_correlation(model: EditableModel, target: MapTarget) -> Callable[[np.ndarray], tuple[float, np.ndarray]]:
@@ -174,12 +176,12 @@ def fit_map_levels(
     or giving way past :data:`GIVE_WAY` Å, whichever fits the level better, and less ``hold``
     times the mean squared move of the fitted atoms from where the level began. Each level
     fits into the map as it sees it (:func:`level_resolution`), and its score is the CC
-    with that map."""
+    with that map; levels finer than the map resolves are left out (:func:`resolved_levels`)."""
     ca = ca_rows(model.structure)[np.concatenate([model.segments[s].residue_index for s in segments])]
     networks: list[ElasticNetwork] = []  # at rest as the levels begin (after the domains)
     rows = _segment_rows(model, segments)
 
-    for level in levels:
+    for level in resolved_levels(model, segments, levels, target.resolution):
         if cancelled():
             return
         if level == DOMAINS:
@@ -202,14 +204,36 @@ def fit_map_levels(
         yield LevelFit(level, n_points, cc, time.perf_counter() - start, tuple(planned), at.resolution)
 
 
+def resolved_levels(model: EditableModel, segments: Sequence[int], levels: Sequence[int], resolution: float
+                    ) -> list[int]:
+    """``levels`` less those whose control points sample a map of ``resolution`` Å finer than
+    it resolves: spaced less than half the resolution apart (:data:`RESOLUTION_PER_RESIDUE`
+    times the residues of a span, on average; two samples across the finest detail, as
+    Nyquist's rule asks). The domain stage and the coarsest level asked for are kept. Such a
+    level's control points are held by nothing but the elastic network and the hold: in a
+    homologue's 10 Å map HPr's level 6 (1.4 residues a span) bent the backbone into the other
+    protein's side chains, breaking 57 peptide junctions, which the regularization closed one
+    of two ways as the last bits of the start fell (fits 0.36 Å apart; to level 5, 0.03 Å).
+    The refinement moves each residue after the levels."""
+    fitted = [level for level in levels if level != DOMAINS]
+    coarsest = min(fitted, default=None)
+    return [level for level in levels if level in (DOMAINS, coarsest)
+            or RESOLUTION_PER_RESIDUE * _span(model, segments, level) >= resolution / 2.0]
+
+
+def _span(model: EditableModel, segments: Sequence[int], level: int) -> float:
+    """Residues between ``level``'s control points of ``segments``, on average."""
+    return float(np.mean([len(model.segments[s].residue_index) / 2 ** min(level, model.ribbons[s].level)
+                          for s in segments]))
+
+
 def level_resolution(model: EditableModel, segments: Sequence[int], level: int, resolution: float) -> float:
     """Å, the resolution a map of ``resolution`` Å is blurred to for ``level``'s control
     points of ``segments``: :data:`RESOLUTION_PER_RESIDUE` times the residues of a span
     between them (on average), at least :data:`LEVELS_RESOLUTION` and the map's own, at most
     the coarsest a fit takes."""
-    residues = np.mean([len(model.segments[s].residue_index) / 2 ** min(level, model.ribbons[s].level)
-                        for s in segments])
-    return float(np.clip(RESOLUTION_PER_RESIDUE * residues, max(LEVELS_RESOLUTION, resolution), RESOLUTION[1]))
+    return float(np.clip(RESOLUTION_PER_RESIDUE * _span(model, segments, level), max(LEVELS_RESOLUTION, resolution),
+                         RESOLUTION[1]))
 
 
 def _fit_level(model: EditableModel, segments: Sequence[int], level: int,
@@ -298,8 +322,9 @@ def refine(
     for cycle in range(cycles):
         if cancelled():
             break
-        correlation = atom_correlation(model, target.blurred(target.resolution * REFINE_FIRST_BLUR)
-                                       if cycle == 0 and cycles > 1 else target)
+        blurred = cycle == 0 and cycles > 1  # (at most to the coarsest resolution a fit takes)
+        correlation = atom_correlation(model, target.blurred(min(target.resolution * REFINE_FIRST_BLUR, RESOLUTION[1]))
+                                       if blurred else target)
         evaluate = _restrained(correlation, network, ca, stiffness, rows, model.coords[rows], hold)
         moved = refine_real_space(model, segments, partial(_without_cc, evaluate), cancelled=cancelled)
         for edit in moved:

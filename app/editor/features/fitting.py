@@ -29,7 +29,7 @@ from app.editor.document import Document
 from app.editor.scene.overlay import Compared, chain_segments
 from core.fitting.coarse_to_fine import LevelFit, fit_levels
 from core.fitting.conformation import SAME_FOLD, fold_similarity, pair_segments
-from core.fitting.density import fit_map_levels, refine
+from core.fitting.density import fit_map_levels, refine, resolved_levels
 from core.fitting.domains import DOMAINS
 from core.fitting.map_target import MapTarget, heavy_atoms
 from core.fitting.settle import settle
@@ -56,6 +56,9 @@ class FitTarget:
     domains: bool = False
     """For a map: coarse to fine, the chain's smaller dynamic domain is first moved as a rigid
     body (:mod:`core.fitting.domains`), a stage of its own."""
+    resolved: Callable[[list[int]], list[int]] = list
+    """The levels asked for that the target can hold (a map: not those finer than it resolves,
+    :func:`core.fitting.density.resolved_levels`)."""
 
 
 def edited_chain(document: Document) -> list[int]:
@@ -73,7 +76,8 @@ def map_target(document: Document, density: DensityMap, resolution: float) -> Fi
     return FitTarget("map", lambda levels, cancelled: fit_map_levels(model, segments, target, levels,
                                                                        cancelled=cancelled),
                      lambda fit: f"CC {fit.score:.3f} at {fit.resolution:.3g} Å",
-                     lambda cancelled: refine(model, segments, target, cancelled=cancelled), domains=True)
+                     lambda cancelled: refine(model, segments, target, cancelled=cancelled), domains=True,
+                     resolved=lambda levels: resolved_levels(model, segments, levels, resolution))
 
 
 def compared_target(document: Document, compared: Compared) -> FitTarget:
@@ -95,11 +99,12 @@ def compared_target(document: Document, compared: Compared) -> FitTarget:
 
 def levels_to_fit(document: Document, target: FitTarget, coarse_to_fine: bool) -> list[int]:
     """The integer level at or below the one shown, or every level from 0 up to it (after
-    the domains, :data:`~core.fitting.domains.DOMAINS`, where ``target`` moves them first)."""
+    the domains, :data:`~core.fitting.domains.DOMAINS`, where ``target`` moves them first),
+    less those ``target`` cannot hold (:attr:`FitTarget.resolved`)."""
     level = math.floor(document.shown_level())
     if not coarse_to_fine:
         return [level]
-    return [DOMAINS] * target.domains + list(range(level + 1))
+    return target.resolved([DOMAINS] * target.domains + list(range(level + 1)))
 
 
 def _stage(level: int) -> str:

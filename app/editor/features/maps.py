@@ -4,6 +4,7 @@ fits themselves: :mod:`app.editor.features.fitting`, loaded with the first)."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -111,13 +112,17 @@ class MapsAndFits:
                 raise
             QMessageBox.critical(self.window, PROG, str(error))
             return []
+        shown, unheld = math.floor(document.shown_level()), ""
         if levels is None:
             levels = levels_to_fit(document, fit_target, coarse_to_fine)
+            if max(levels) < shown:
+                unheld = (f" (levels {max(levels) + 1}–{shown} left out: finer than the map resolves at "
+                          f"{self.correlation.resolution:.3g} Å; each residue refined instead)")
         kept = run_fit(document, fit_target, levels, self.window)
         if target == "map" and kept:
             self.correlation.judge()  # now, not after the edits' pause
-            if self.correlation.quality is not None:
-                self.window.statusBar().showMessage(f"Fitted to the map: {self.correlation.summary()}", 30000)
+            judged = f": {self.correlation.summary()}" if self.correlation.quality is not None else ""
+            self.window.statusBar().showMessage(f"Fitted to the map{judged}{unheld}", 30000)
         return kept
 
     def _compared(self) -> Compared:

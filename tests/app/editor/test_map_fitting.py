@@ -207,6 +207,18 @@ def test_fit_to_map_coarse_to_fine_is_one_step_a_level_and_a_regularization(wind
     assert np.array_equal(document.model.coords, document.structure.coords)
 
 
+def test_levels_finer_than_the_map_resolves_are_left_out_and_the_status_bar_says_so(window: MainWindow) -> None:
+    """At 30 Å the map resolves adenylate kinase's level 4 (its control points 13 residues,
+    27 Å apart), not level 5 (13 Å, less than half the resolution): coarse to fine from
+    level 6, levels 5-6 are left out and each residue is refined after level 4."""
+    window.document.set_level(6)
+    fitted = window.rw.fit_to_map(resolution=30.0)
+    assert [level for level, _ in fitted] == [DOMAINS, 0, 1, 2, 3, 4]
+    assert "levels 5–6 left out: finer than the map resolves at 30 Å" in window.statusBar().currentMessage()
+    steps, index = window.rw.history()
+    assert steps[index - 1] == "Refine the fit to map (each residue, side chains)"
+
+
 def test_a_fit_moves_every_segment_of_the_edited_chain_in_one_step_a_level(
     open_window: Callable[[str], MainWindow], tmp_path: Path
 ) -> None:

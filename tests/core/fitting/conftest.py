@@ -18,18 +18,26 @@ PERTURBATION = 0.001
 """Å: how far each coordinate of a perturbed start moves, at most (uniformly)."""
 
 
+def perturbed(structure: Structure, seed: int, folder: Path) -> Structure:
+    """``structure`` itself for seed 0, else with every coordinate moved by up to
+    :data:`PERTURBATION` Å, written to ``folder`` and read again (as another program's file
+    would be)."""
+    if seed == 0:
+        return structure
+    jitter = np.random.default_rng(seed).uniform(-PERTURBATION, PERTURBATION, structure.coords.shape)
+    written = folder / f"{seed}_{structure.path.name.removesuffix('.gz')}"
+    return read_structure(write_structure(structure, structure.coords + jitter, written))
+
+
 @pytest.fixture(params=STARTS, ids=lambda seed: "as-read" if seed == 0 else f"perturbed-{seed}")
 def fit_start(request: pytest.FixtureRequest, tmp_path: Path) -> Callable[[Path], Structure]:
-    """Reads the start of a fit: the file as read, or with every coordinate moved by up to
-    :data:`PERTURBATION` Å (written and read again, as another program's file would be);
-    a test using it runs from each of :data:`STARTS`."""
-    seed = request.param
+    """Reads the start of a fit: the file as read, or :func:`perturbed`; a test using it runs
+    from each of :data:`STARTS`."""
+    return lambda path: perturbed(read_structure(path), request.param, tmp_path)
 
-    def start(path: Path) -> Structure:
-        structure = read_structure(path)
-        if seed == 0:
-            return structure
-        jitter = np.random.default_rng(seed).uniform(-PERTURBATION, PERTURBATION, structure.coords.shape)
-        written = write_structure(structure, structure.coords + jitter, tmp_path / path.name.removesuffix(".gz"))
-        return read_structure(written)
-    return start
+
+@pytest.fixture
+def every_start(tmp_path: Path) -> Callable[[Structure], list[Structure]]:
+    """The starts of a fit whose results are compared with each other: ``structure`` from
+    each of :data:`STARTS` (:func:`perturbed`)."""
+    return lambda structure: [perturbed(structure, seed, tmp_path) for seed in STARTS]

@@ -8,7 +8,10 @@ import numpy as np
 import pytest
 from scipy import ndimage, sparse
 
-from core.fitting.density import atom_correlation, fit_map, refine
+from core.analysis.superpose import superpose
+from core.fitting.conformation import pair_segments
+from core.fitting.density import atom_correlation, fit_map, refine, resolved_levels
+from core.fitting.domains import DOMAINS
 from core.fitting.map_target import MapTarget, gaussian_sigma, heavy_atoms
 from core.fitting.real_space import ResidueBodies, refine_real_space
 from core.fitting.side_chains import side_chain_rotors
@@ -17,6 +20,8 @@ from core.geometry.topology import topology
 from core.geometry.validation import validate
 from core.protein.model import EditableModel
 from core.protein.reading import read_structure
+from core.protein.structure import ca_rows
+from core.protein.writing import write_structure
 from core.surfaces.volume import DensityMap
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -87,6 +92,41 @@ def test_a_fit_into_a_map_cut_sharply_in_fourier_space_is_not_held_by_its_ripple
     assert not fit_map(start, [0], target, range(0, 7)).dropped
     ca = start.structure.atoms.name == "CA"
     assert np.sqrt(np.mean(np.sum((start.coords[ca] - adk.coords[ca]) ** 2, axis=1))) < 2.0
+
+
+def test_the_levels_fitted_into_a_map_are_those_it_resolves(adk: EditableModel) -> None:
+    """Two Å per residue of a span between control points, at least half the resolution:
+    adenylate kinase's level 6 spans 3.3 residues (6.7 Å), level 5 6.7 (13 Å), level 4 13
+    (27 Å); the domain stage and the coarsest level asked for stay."""
+    every = [DOMAINS, *range(7)]
+    assert resolved_levels(adk, [0], every, 6.0) == resolved_levels(adk, [0], every, 10.0) == every
+    assert resolved_levels(adk, [0], every, 20.0) == [DOMAINS, 0, 1, 2, 3, 4, 5]
+    assert resolved_levels(adk, [0], every, 30.0) == [DOMAINS, 0, 1, 2, 3, 4]
+    assert resolved_levels(adk, [0], [5, 6], 30.0) == [5]
+
+
+def test_a_homologue_fitted_into_a_10_angstrom_map_ends_at_one_model_from_every_start(
+        every_start: Callable, tmp_path: Path) -> None:
+    """HPr of *E. coli* (1POH) into a 10 Å map of *B. subtilis*'s (2HPR), placed on it by their
+    paired Cα: with level 6 (1.4 residues a span) the backbone bent into the other protein's
+    side chains, 57 junctions broke, and the regularization closed them one of two ways as
+    the last bits of the start fell (fits 0.36 Å apart). The map resolves levels 0-5; fitted
+    from starts 0.001 Å apart, the models end within 0.1 Å of each other."""
+    start, end = read_structure(DATA / "1POH_A.pdb.gz"), read_structure(DATA / "2HPR_A.pdb.gz")
+    pairs, _ = pair_segments(EditableModel(start), [0], [end.segments[0]])
+    rows = ca_rows(start)[start.segments[0].residue_index[pairs[0].residues]]
+    placed = read_structure(write_structure(start, superpose(pairs[0].target, start.coords[rows]).apply(start.coords),
+                                            tmp_path / "1POH_placed.pdb"))
+    target = MapTarget(molmap(end, 10.0), 10.0, placed.coords[heavy_atoms(EditableModel(placed))])
+    fitted = []
+    for structure in every_start(placed):
+        model = EditableModel(structure)
+        result = fit_map(model, [0], target, [DOMAINS, *range(7)])
+        assert [fit.level for fit in result.levels] == [DOMAINS, 0, 1, 2, 3, 4, 5] and result.refinement
+        assert target.correlation(model.coords[heavy_atoms(model)]) > 0.99
+        fitted.append(model.coords[rows])
+    apart = max(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=1))) for a in fitted for b in fitted)
+    assert 0.0 < apart <= 0.1  # (0: the starts were not perturbed)
 
 
 def test_the_rotors_are_the_iupac_torsions_and_keep_every_bond(adk: EditableModel) -> None:
