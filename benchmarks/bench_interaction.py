@@ -1,8 +1,8 @@
 """End to end: a real Qt event sent to a real editor window, timed until its frame is drawn.
 
-Usage: ``xvfb-run -a python benchmarks/bench_interaction.py [--steps N] [--views KIND ...] [STRUCTURE ...]``
-(default: 1UBQ, 1AYE, 4YVS from tests/data, each in both 3D views: VTK's native window and
-pyvistaqt's OpenGL widget, side by side). Each event goes through Qt as the mouse or the
+Usage: ``xvfb-run -a python benchmarks/bench_interaction.py [--steps N] [--views KIND ...] [--shown REP ...]
+[STRUCTURE ...]`` (default: 1UBQ, 1AYE, 4YVS from tests/data, each in both 3D views: VTK's native window and
+pyvistaqt's OpenGL widget, and with the cartoon or the tube shown, side by side). Each event goes through Qt as the mouse or the
 keyboard sends it (QTest), and the clock stops once the event loop has nothing left to do,
 the render included; a counter on the render window says how many frames each event drew,
 and, in the OpenGL widget, one on the view how many times the window was composed (with
@@ -34,9 +34,12 @@ from PySide6.QtWidgets import QApplication
 
 from app.editor.document import Document
 from app.editor.main_window import MainWindow
+from app.editor.scene.layers.base import Layer
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
 DEFAULT = ("1UBQ.pdb.gz", "1AYE.pdb.gz", "4YVS.cif.gz")
+SHOWN = {"cartoon": Layer.CARTOON, "tube": Layer.TUBE}
+"""The ribbon shown (the other hidden) in a run."""
 
 
 class Frames:
@@ -90,9 +93,10 @@ def _timed(app: QApplication, frames: Frames, send) -> tuple[float, float, int, 
             frames.compositions - composed)
 
 
-def measure(app: QApplication, path: Path, steps: int, view_kind: str) -> dict[str, list[tuple[float, float, int, int]]]:
+def measure(app: QApplication, path: Path, steps: int, view_kind: str, shown: str
+            ) -> dict[str, list[tuple[float, float, int, int]]]:
     """Times and frame counts of every kind of event on the structure at ``path``, in the 3D
-    view ``view_kind``."""
+    view ``view_kind``, with the ribbon ``shown`` (:data:`SHOWN`)."""
     os.environ["RIBBONWAVE_VIEW"] = view_kind
     document = Document()
     document.open(path)
@@ -100,6 +104,8 @@ def measure(app: QApplication, path: Path, steps: int, view_kind: str) -> dict[s
     window.resize(1400, 900)
     window.show()
     QTest.qWaitForWindowExposed(window)
+    for name, layer in SHOWN.items():
+        window.scene.set_layer(layer, name == shown)
     _settle(app)
     frames = Frames(window)
     view = window.plotter
@@ -156,24 +162,27 @@ def main() -> None:
     parser.add_argument("structures", nargs="*", default=list(DEFAULT))
     parser.add_argument("--steps", type=int, default=20)
     parser.add_argument("--views", nargs="+", choices=("native", "widget"), default=["native", "widget"])
+    parser.add_argument("--shown", nargs="+", choices=tuple(SHOWN), default=list(SHOWN))
     args = parser.parse_args()
     app = QApplication.instance() or QApplication(sys.argv[:1])
     QSettings.setPath(QSettings.Format.NativeFormat, QSettings.Scope.UserScope, tempfile.mkdtemp())  # not the user's
-    print(f"{'structure':<12} {'view':<7} {'event':<12} {'median ms':>10} {'p90 ms':>8} {'render ms':>10} "
+    print(f"{'structure':<12} {'view':<7} {'shown':<8} {'event':<12} {'median ms':>10} {'p90 ms':>8} {'render ms':>10} "
           f"{'frames/event':>13} {'compositions/event':>19}")
     for name in args.structures:
         path = Path(name) if Path(name).exists() else DATA / name
         entry = path.name.split('.')[0]
         for view_kind in args.views:
-            results = measure(app, path, args.steps, view_kind)
-            for kind, samples in results.items():
-                times, drawing, counts, compositions = np.array(samples).T
-                composed = f"{np.mean(compositions):.2f}" if view_kind == "widget" else "-"
-                print(f"{entry:<12} {view_kind:<7} {kind:<12} {np.median(times):>10.1f} "
-                      f"{np.percentile(times, 90):>8.1f} {np.median(drawing):>10.1f} {np.mean(counts):>13.2f} "
-                      f"{composed:>19}")
-            moving, rest = (np.median(np.array(results[kind])[:, 1]) for kind in ("rotate step", "at rest"))
-            print(f"{entry:<12} {view_kind:<7} frames in motion {rest / moving:.1f}x cheaper than at rest")
+            for shown in args.shown:
+                results = measure(app, path, args.steps, view_kind, shown)
+                for kind, samples in results.items():
+                    times, drawing, counts, compositions = np.array(samples).T
+                    composed = f"{np.mean(compositions):.2f}" if view_kind == "widget" else "-"
+                    print(f"{entry:<12} {view_kind:<7} {shown:<8} {kind:<12} {np.median(times):>10.1f} "
+                          f"{np.percentile(times, 90):>8.1f} {np.median(drawing):>10.1f} {np.mean(counts):>13.2f} "
+                          f"{composed:>19}")
+                moving, rest = (np.median(np.array(results[kind])[:, 1]) for kind in ("rotate step", "at rest"))
+                print(f"{entry:<12} {view_kind:<7} {shown:<8} frames in motion {rest / moving:.1f}x cheaper than at "
+                      "rest")
 
 
 if __name__ == "__main__":

@@ -126,7 +126,7 @@ def open_arguments(parser: argparse.ArgumentParser) -> None:
         nargs="+",
         default=[],
         metavar="LAYER",
-        help="layers to start hidden, e.g. tube control-points (see the Display dock)",
+        help="layers to start hidden, e.g. cartoon control-points (see the Display dock)",
     )
 
 

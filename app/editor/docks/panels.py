@@ -37,7 +37,7 @@ from core.protein.ribbon import RibbonKind
 STEPS_PER_LEVEL = 100
 """Slider positions per level: fractional levels in steps of 0.01."""
 KIND_NAMES = {RibbonKind.PEPTIDE: "peptide-plane ribbon", RibbonKind.CALPHA: "Cα ribbon"}
-BACKBONE_LAYERS = (Layer.TUBE, Layer.CURVE, Layer.CONTROL_POINTS, Layer.CA_TRACE)
+BACKBONE_LAYERS = (Layer.CARTOON, Layer.TUBE, Layer.CURVE, Layer.CONTROL_POINTS, Layer.CA_TRACE)
 """Layers drawn from the backbone: nothing to show for a structure that is only viewed."""
 
 
@@ -213,18 +213,22 @@ class DisplayPanel(QWidget):
         super().__init__(parent)
         self.scene = scene
         layers = QGroupBox("Layers")
-        layer_box = QGridLayout(layers)  # two columns: the dock fits a laptop's height
+        layer_box = QGridLayout(layers)  # three columns: the dock fits a laptop's height
         self.layer_boxes: dict[Layer, QCheckBox] = {}
         for k, layer in enumerate(Layer):
             box = QCheckBox(layer.value[0].upper() + layer.value[1:])
             box.setChecked(layer in scene.layers)
             box.toggled.connect(lambda on, layer=layer: scene.set_layer(layer, on))
-            layer_box.addWidget(box, k // 2, k % 2)
+            layer_box.addWidget(box, k // 3, k % 3)
             self.layer_boxes[layer] = box
         self.colouring = QComboBox()
         for colouring in Colouring:
             self.colouring.addItem(colouring.value[0].upper() + colouring.value[1:], colouring)
-        self.fat = QCheckBox("Fat helices (radius by secondary structure)")
+        self.fat = QCheckBox("Fat tube")
+        self.fat.setToolTip("The tube's radius by secondary structure: sheet > helix > other")
+        self.cylinders = QCheckBox("Helices as cylinders")
+        self.cylinders.setToolTip("The cartoon's helices as cylinders along their axes (Carson's Fig. 5), not spiral "
+                                  "ribbons")
         self.others = QComboBox()
         for others in Others:
             self.others.addItem(f"Other chains {others.value}", others)
@@ -236,7 +240,10 @@ class DisplayPanel(QWidget):
         colours = QGroupBox("Ribbon colours")
         colour_box = QVBoxLayout(colours)
         colour_box.addWidget(self.colouring)
-        colour_box.addWidget(self.fat)
+        shapes = QHBoxLayout()
+        shapes.addWidget(self.cylinders)
+        shapes.addWidget(self.fat)
+        colour_box.addLayout(shapes)
         colour_box.addWidget(self.others)
         colour_box.addWidget(self.legend)
         layout = QVBoxLayout(self)
@@ -245,6 +252,7 @@ class DisplayPanel(QWidget):
         layout.addStretch(1)
         self.colouring.currentIndexChanged.connect(self._colouring_changed)
         self.fat.toggled.connect(scene.set_fat_helices)
+        self.cylinders.toggled.connect(scene.set_helix_cylinders)
         self.others.currentIndexChanged.connect(lambda: scene.set_others(self.others.currentData()))
         self.colours = colours
         scene.document.loaded.connect(self._loaded)

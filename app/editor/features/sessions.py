@@ -145,7 +145,7 @@ class Sessions:
                     for item in self.comparison.items]
         camera = [list(map(float, vector)) for vector in self.plotter.camera_position]
         return session.View(sorted(layer.name for layer in self.scene.layers), self.scene.colouring.value,
-                            self.scene.fat_helices, camera, compared)
+                            self.scene.fat_helices, camera, compared, self.scene.helix_cylinders)
 
     def _apply_view(self, view: session.View) -> None:
         for layer, box in self.display_panel.layer_boxes.items():
@@ -153,6 +153,7 @@ class Sessions:
         panel = self.display_panel
         panel.colouring.setCurrentIndex(max(panel.colouring.findData(Colouring(view.colouring)), 0))
         panel.fat.setChecked(view.fat_helices)
+        panel.cylinders.setChecked(view.helix_cylinders)
         for item in view.compared:
             try:
                 self.comparison.add(item.path, item.chain, item.source)

@@ -43,11 +43,12 @@ class View:
     fat_helices: bool
     camera: list[list[float]]
     compared: list[ComparedFile]
+    helix_cylinders: bool = False
 
     def record(self) -> records.Record:
         """The ``view`` record of this view."""
         fields = {"layers": self.layers, "colouring": self.colouring, "fat_helices": self.fat_helices,
-                  "camera": self.camera,
+                  "helix_cylinders": self.helix_cylinders, "camera": self.camera,
                   "compared": [{"path": str(c.path), "chain": c.chain, "visible": c.visible} for c in self.compared]}
         arrays = {f"compared_{k}": np.frombuffer(c.source, dtype=np.uint8) for k, c in enumerate(self.compared)}
         return records.Record("view", fields, arrays)
@@ -58,7 +59,8 @@ class View:
         fields = record.fields
         compared = [ComparedFile(Path(c["path"]), record.arrays[f"compared_{k}"].tobytes(), c["chain"], c["visible"])
                     for k, c in enumerate(fields["compared"])]
-        return cls(fields["layers"], fields["colouring"], fields["fat_helices"], fields["camera"], compared)
+        return cls(fields["layers"], fields["colouring"], fields["fat_helices"], fields["camera"], compared,
+                   fields.get("helix_cylinders", False))  # (not in sessions written before the cartoon)
 
 
 def write(path: Path, recording: list[records.Record], view: View) -> None:

@@ -88,14 +88,16 @@ class SegmentPath:
         ring[(np.asarray(residues)[:, None] * k + np.arange(k + 1)).ravel()] = True
         return np.flatnonzero(ring)
 
-    def centres(self, points: np.ndarray, rings: np.ndarray | slice = slice(None)) -> tuple[np.ndarray, np.ndarray]:
-        """Curve points (r, 3) and unit tangents (r, 3) of the finest curve at ``rings``.
+    def centres(self, points: np.ndarray, rings: np.ndarray | slice = slice(None), level: int | None = None
+                ) -> tuple[np.ndarray, np.ndarray]:
+        """Curve points (r, 3) and unit tangents (r, 3) at ``rings`` of the curve of control
+        points ``points`` of ``level`` (default: the finest, the ribbon's).
 
         Where the first derivative vanishes (the curve's very ends, over the doubled
         terminal control points) the tangent is the direction from which the curve arrives
         there, given by the second derivative.
         """
-        space = spline_space(self.finest)
+        space = spline_space(self.finest if level is None else level)
         u = self.u[rings]
         derivative = space.evaluate(points, u, 1)
         length = np.linalg.norm(derivative, axis=1)

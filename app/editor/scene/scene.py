@@ -24,6 +24,7 @@ from app.editor.scene import molecule
 from app.editor.scene.layers.atoms import AtomsLayer
 from app.editor.scene.layers.base import Layer, SceneLayer
 from app.editor.scene.layers.ca_trace import CaTraceLayer
+from app.editor.scene.layers.cartoon import CartoonLayer
 from app.editor.scene.layers.chains import DIM_ABOVE_CHAINS, Chains, Others, faded
 from app.editor.scene.layers.control_points import ControlPointsLayer
 from app.editor.scene.layers.level_curve import CurveLayer
@@ -36,6 +37,7 @@ if TYPE_CHECKING:
     from app.editor.scene.view_base import View
 
 LAYERS: tuple[type[SceneLayer], ...] = (
+    CartoonLayer,
     TubeLayer,
     CurveLayer,
     CaTraceLayer,
@@ -46,7 +48,7 @@ LAYERS: tuple[type[SceneLayer], ...] = (
     IonsLayer,
 )
 """The layers every scene draws, in this order (the validation markers add themselves)."""
-DEFAULT_LAYERS = {Layer.TUBE, Layer.CURVE, Layer.CONTROL_POINTS, Layer.LIGANDS, Layer.IONS, Layer.VALIDATION}
+DEFAULT_LAYERS = {Layer.CARTOON, Layer.CURVE, Layer.CONTROL_POINTS, Layer.LIGANDS, Layer.IONS, Layer.VALIDATION}
 STILL_AFTER_MS = 250
 """Full detail comes back once nothing has moved for this long."""
 CAPTION_COLOUR = "#2b2f36"
@@ -67,6 +69,7 @@ class Scene(QObject):
         """The layers switched on."""
         self.colouring = Colouring.SECONDARY_STRUCTURE
         self.fat_helices = False
+        self.helix_cylinders = False
         self.others = Others.SHOWN
         self.chains: Chains
         """The residues' chains (set when an editable structure is built)."""
@@ -115,6 +118,14 @@ class Scene(QObject):
     def set_fat_helices(self, on: bool) -> None:
         """Tube radius by secondary structure (sheet > helix > other) or uniform."""
         self.fat_helices = on
+        if self.document.editable:
+            for layer in self._drawn:
+                layer.reshape()
+            self.plotter.render()
+
+    def set_helix_cylinders(self, on: bool) -> None:
+        """Helices of the cartoon as cylinders along their axes (Carson's Fig. 5), or spiral ribbons."""
+        self.helix_cylinders = on
         if self.document.editable:
             for layer in self._drawn:
                 layer.reshape()

@@ -288,8 +288,10 @@ def test_other_chains_dimmed_hidden_and_shown(open_window: Opener) -> None:
     scene = window.scene
     assert scene.others is Others.DIMMED and Others(window.display_panel.others.currentData()) is Others.DIMMED
     document = window.document
+    window.scene.set_layer(Layer.CARTOON, False)  # the tube: its layout does not follow the level
+    window.scene.set_layer(Layer.TUBE, True)
     tube = window.scene.meshes["tube"]
-    rings = window.scene.part(TubeLayer).ring_start  # the tube's layout
+    rings = window.scene.part(TubeLayer).ring_start
     chains = [s.chain for s in document.structure.segments]
     k = next(k for k, chain in enumerate(chains) if chain != chains[0])
     edited, other = (slice(rings[g] * TUBE_SIDES, rings[g + 1] * TUBE_SIDES) for g in (0, k))

@@ -118,7 +118,7 @@ def test_a_drag_step_changes_the_validation_dock_with_its_frame(qtbot: QtBot, vi
 def test_a_screenshot_shows_a_change_not_drawn_yet(view_kind: str, open_window: Opener) -> None:
     window = open_window("1UBQ.pdb.gz")
     before = window.plotter.screenshot(return_img=True).astype(int)
-    window.scene.set_layer(Layer.TUBE, False)  # asks for a frame; none is drawn before the loop turns
+    window.scene.set_layer(Layer.CARTOON, False)  # asks for a frame; none is drawn before the loop turns
     after = window.plotter.screenshot(return_img=True).astype(int)
     assert np.count_nonzero(np.abs(after - before).sum(axis=2) > 30) > 5000
 

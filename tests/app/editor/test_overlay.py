@@ -164,7 +164,7 @@ def test_new_structure_refits_and_bad_files_are_reported(window: MainWindow, tmp
 
 def test_command_line_compare_screenshot(qtbot: QtBot, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "fig8.png"
-    status = main([str(DATA / "3PTB.pdb.gz"), "--level", "4", "--hide", "tube", "control-points",
+    status = main([str(DATA / "3PTB.pdb.gz"), "--level", "4", "--hide", "cartoon", "control-points",
                    "--compare", f"{PROTEASES[0]}:E", str(PROTEASES[1]), "--screenshot", str(out)])
     assert status == 0 and out.stat().st_size > 10_000
     other = tmp_path / "other.png"

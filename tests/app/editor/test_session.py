@@ -65,11 +65,13 @@ def test_the_view_and_compared_structures_come_back(qtbot: QtBot, tmp_path: Path
     window = _window(qtbot, DATA / "3PTB.pdb.gz")
     window.comparison.add(compared)
     window.comparison.set_visible(0, False)
-    window.display_panel.layer_boxes[Layer.TUBE].setChecked(False)
+    window.display_panel.layer_boxes[Layer.CARTOON].setChecked(False)
+    window.display_panel.layer_boxes[Layer.TUBE].setChecked(True)
     window.display_panel.layer_boxes[Layer.ATOMS].setChecked(True)
     panel = window.display_panel
     panel.colouring.setCurrentIndex(panel.colouring.findData(Colouring.CHAIN))
     panel.fat.setChecked(True)
+    panel.cylinders.setChecked(True)
     window.plotter.camera.azimuth = 40
     camera = np.array([tuple(v) for v in window.plotter.camera_position])
     layers = set(window.scene.layers)
@@ -78,6 +80,7 @@ def test_the_view_and_compared_structures_come_back(qtbot: QtBot, tmp_path: Path
     other = _window(qtbot, DATA / "1UBQ.pdb.gz")
     assert other.sessions.open_session(saved)
     assert other.scene.layers == layers and other.scene.colouring is Colouring.CHAIN and other.scene.fat_helices
+    assert other.scene.helix_cylinders and other.display_panel.cylinders.isChecked()
     assert np.allclose([tuple(v) for v in other.plotter.camera_position], camera)
     assert [(item.structure.entry_id, item.visible) for item in other.comparison.items] == [("1BMA", False)]
     before, after = window.comparison.items[0].fit, other.comparison.items[0].fit

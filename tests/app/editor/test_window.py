@@ -107,10 +107,10 @@ def test_bundled_example_is_ubiquitin(qapp: QApplication) -> None:
 
 def test_window_shows_the_structure(window: MainWindow) -> None:
     assert window.windowTitle() == "1UBQ.pdb.gz[*] — ribbonwave" and not window.isWindowModified()
-    tube = window.scene.meshes["tube"]
-    assert tube.n_points == (76 * 6 + 1) * TUBE_SIDES + 2 * (TUBE_SIDES + 1)
-    assert window.plotter.actors["tube"].GetVisibility()
-    colours = {tuple(c) for c in tube.point_data["colours"]}
+    cartoon = window.scene.meshes["cartoon"]
+    assert cartoon.n_points == (76 * 6 + 1) * TUBE_SIDES + 2 * (TUBE_SIDES + 1)
+    assert window.plotter.actors["cartoon"].GetVisibility() and not window.plotter.actors["tube"].GetVisibility()
+    colours = {tuple(c) for c in cartoon.point_data["colours"]}
     assert set(molecule.SS_COLOURS.values()) <= colours
     assert "ions" not in window.plotter.actors  # ubiquitin has none
     assert window.status.labels["segment"].text() == "chain A  MET1–GLY76 (76 residues)"
@@ -176,15 +176,19 @@ def test_layers_colours_and_fat_helices(window: MainWindow) -> None:
     panel = window.display_panel
     panel.layer_boxes[Layer.ATOMS].setChecked(True)
     assert window.plotter.actors["atoms"].GetVisibility()
+    panel.layer_boxes[Layer.TUBE].setChecked(True)  # swept now: it sweeps nothing while hidden
+    assert window.plotter.actors["tube"].GetVisibility()
     panel.layer_boxes[Layer.TUBE].setChecked(False)
     assert not window.plotter.actors["tube"].GetVisibility()
     panel.layer_boxes[Layer.CONTROL_POINTS].setChecked(False)
     assert not window.plotter.actors["control_points"].GetVisibility()
     panel.colouring.setCurrentIndex(panel.colouring.findData(Colouring.RESIDUE_TYPE))
-    colours = window.scene.meshes["tube"].point_data["colours"]
+    colours = window.scene.meshes["cartoon"].point_data["colours"]
     assert tuple(colours[0]) == molecule.RESIDUE_CLASSES["hydrophobic"][0]  # Met1
     assert panel.legend_layout.rowCount() == len(molecule.RESIDUE_CLASSES)
+    panel.layer_boxes[Layer.TUBE].setChecked(True)  # swept and coloured as it is shown again
     tube = window.scene.meshes["tube"]
+    assert tuple(tube.point_data["colours"][0]) == molecule.RESIDUE_CLASSES["hydrophobic"][0]
     centre = window.document.paths[0]
     before = np.array(tube.points)
     panel.fat.setChecked(True)
@@ -287,6 +291,7 @@ def test_a_drag_with_qt_mouse_events(qtbot: QtBot, window: MainWindow) -> None:
 
 
 def test_undo_puts_the_tube_back_exactly(window: MainWindow) -> None:
+    window.display_panel.layer_boxes[Layer.TUBE].setChecked(True)
     tube = np.array(window.scene.meshes["tube"].points)
     _drag_control_point(window, 4)
     assert not np.array_equal(window.scene.meshes["tube"].points, tube)

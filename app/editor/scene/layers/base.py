@@ -33,6 +33,7 @@ SHINY = {"interpolation": "phong", "specular": 0.4, "specular_power": 25.0}
 class Layer(StrEnum):
     """What can be shown, each switchable on its own."""
 
+    CARTOON = "cartoon"
     TUBE = "ribbon tube"
     CURVE = "level curve"
     CONTROL_POINTS = "control points"
@@ -62,6 +63,8 @@ class Stage(Protocol):
     def colouring(self) -> Colouring: ...
     @property
     def fat_helices(self) -> bool: ...
+    @property
+    def helix_cylinders(self) -> bool: ...
     @property
     def others(self) -> Others: ...
     @property
@@ -124,7 +127,7 @@ class SceneLayer:
         :meth:`Stage.residue_colours`."""
 
     def reshape(self) -> None:
-        """The tube's radii changed (fat helices or not)."""
+        """The ribbons' sections changed (fat helices or not, helices as cylinders or not)."""
 
     def conceal(self, chain: str) -> None:
         """Collapse the vertices of the chains other than ``chain`` onto one point each (other chains hidden)."""
