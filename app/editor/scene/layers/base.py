@@ -39,6 +39,7 @@ class Layer(StrEnum):
     CONTROL_POINTS = "control points"
     CA_TRACE = "Cα trace"
     ATOMS = "atoms"
+    NUCLEIC = "nucleic acids"
     LIGANDS = "ligands"
     IONS = "ions"
     VALIDATION = "validation markers"

@@ -1,0 +1,53 @@
+"""Nucleic acids drawn by default (#34): a tube through each strand's phosphates and a slab
+per base coloured by base, for a DNA duplex only viewed and beside an edited protein."""
+
+from collections.abc import Callable
+
+import numpy as np
+
+from app.editor.main_window import MainWindow
+from app.editor.scene import nucleic
+from app.editor.scene.layers.base import Layer
+from app.editor.scene.layers.chains import Others
+from app.editor.scene.layers.nucleic import NucleicLayer
+
+Opener = Callable[[str], MainWindow]
+
+
+def test_a_dna_duplex_is_drawn_as_tubes_through_its_phosphates_and_slabs_per_base(open_window: Opener) -> None:
+    window = open_window("1BNA.pdb.gz")  # the Dickerson dodecamer: two strands, no protein
+    scene, atoms = window.scene, window.document.structure.atoms
+    assert not window.document.editable and scene.actors["nucleic_tube"].GetVisibility()
+    found = scene.part(NucleicLayer).found
+    assert len(found) == 24 and list(found.strand_start) == [0, 12, 24]
+    rings = np.asarray(scene.meshes["nucleic_tube"].points).reshape(-1, nucleic.SIDES, 3).mean(axis=1)
+    strand = rings[: 11 * nucleic.SAMPLES + 1]
+    phosphates = atoms.coords[found.backbone[:12]]
+    np.testing.assert_allclose(strand[:: nucleic.SAMPLES], phosphates, atol=1e-4)  # through every phosphorus
+    letters = [str(name)[-1] for name in atoms.resname[found.backbone[:12]]]
+    assert "".join(letters) == "CGCGAATTCGCG"
+    colours = np.asarray(scene.meshes["nucleic_bases"].point_data["colours"])
+    owner = scene.part(NucleicLayer)._base_owner
+    for k, letter in enumerate(letters):
+        assert tuple(colours[owner == k][0]) == nucleic.BASE_COLOURS[letter]
+    outline = found.outline[found.outline_start[4]:found.outline_start[5]]  # A5: a purine's nine ring atoms
+    assert len(outline) == 9
+    bases = np.asarray(scene.meshes["nucleic_bases"].points)[owner == 4]
+    np.testing.assert_allclose(bases[:9], atoms.coords[outline], atol=1e-4)
+    window.display_panel.layer_boxes[Layer.NUCLEIC].setChecked(False)
+    assert not scene.actors["nucleic_tube"].GetVisibility() and not scene.actors["nucleic_bases"].GetVisibility()
+
+
+def test_dna_beside_an_edited_protein_stays_where_it_is_and_hides_with_the_other_chains(open_window: Opener) -> None:
+    window = open_window("1LCD.cif.gz")  # the lac repressor headpiece on its operator
+    scene, document = window.scene, window.document
+    assert document.editable and len(scene.part(NucleicLayer).found) > 20
+    tube = np.array(scene.meshes["nucleic_tube"].points)
+    shown = scene.shown_control_points()
+    window.rw.move(int(shown[len(shown) // 2]), (2.0, 1.0, 0.0))
+    assert np.array_equal(np.array(scene.meshes["nucleic_tube"].points), tube)
+    scene.set_others(Others.HIDDEN)  # the DNA's chains are not the edited one
+    hidden = np.array(scene.meshes["nucleic_tube"].points)
+    assert np.ptp(hidden, axis=0).max() == 0.0
+    scene.set_others(Others.SHOWN)
+    np.testing.assert_array_equal(np.array(scene.meshes["nucleic_tube"].points), tube)
