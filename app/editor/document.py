@@ -27,6 +27,7 @@ from PySide6.QtCore import QObject, QSignalBlocker, Signal
 from PySide6.QtGui import QUndoStack
 
 from app.editor.commands import EditCommand
+from app.editor.measurements import Measurements
 from app.editor.scene.curves import LevelCurve, SegmentPath
 from core.geometry.regularize import FLANK, regularize_region, regularized
 from core.protein.model import Edit, EditableModel
@@ -101,6 +102,8 @@ class Document(QObject):
         """Every preview is regularized (40–110 ms a step on ubiquitin: off by default)."""
         self._curves: dict[int, LevelCurve] = {}
         self._preview: Edit | None = None
+        self.measurements = Measurements(self)
+        """Labels and measurements on atoms (cleared with a new structure)."""
 
     # ------------------------------------------------------------------ state
 
@@ -381,6 +384,8 @@ class Document(QObject):
         """Make ``model`` the document, at the first segment and the default level (or, with
         ``keep_view``, at the segment and level shown, where the new model has them)."""
         segment, level = self.segment, self.level
+        if self.model is None or model.structure is not self.model.structure:
+            self.measurements.replace([])  # (their rows name other atoms)
         self.undo_stack.clear()
         self.model = model
         self.paths = [SegmentPath(ribbon) for ribbon in model.ribbons]

@@ -32,6 +32,7 @@ from app.editor.docks.layout import (
     tidy_tab_bars,
 )
 from app.editor.docks.map_panel import MapPanel
+from app.editor.docks.measurements import MeasurementsPanel
 from app.editor.docks.panels import DisplayPanel, RibbonDimensionPanel
 from app.editor.docks.ramachandran import RamachandranPanel
 from app.editor.docks.sequence import SequenceBar
@@ -43,6 +44,7 @@ from app.editor.features.export import ImageExport
 from app.editor.features.files import Files
 from app.editor.features.help import Help
 from app.editor.features.maps import MapsAndFits
+from app.editor.features.measuring import Measuring
 from app.editor.features.menus import Menus
 from app.editor.features.navigation import Navigation
 from app.editor.features.sessions import Sessions
@@ -110,6 +112,9 @@ class MainWindow(QMainWindow):
         self.sessions = Sessions(self, self.document, self.journal, self.files, self.menus, plotter=self.plotter,
                                  scene=self.scene, display_panel=self.display_panel, comparison=self.comparison)
         self.editing = Editing(self, self.document, self.controller, self.menus)
+        self.measuring = Measuring(self, self.document, self.menus)
+        self.editing.cancel_action.triggered.connect(lambda: self.measuring.use(0))  # Esc stops a tool too
+        self.measurements_panel = MeasurementsPanel(self.document)
         self.help = Help(self, self.menus)
         self.history = QUndoView(self.document.undo_stack)
         self.history.setEmptyLabel("<structure as read>")
@@ -122,7 +127,8 @@ class MainWindow(QMainWindow):
         self.status = StatusBar(self.statusBar(), self.document, self.controller, self.correlation)
         self.editing.modeChanged.connect(self.status.update)
         self.gestures = Gestures(self.document, self.plotter, self.scene, self.controller,
-                                 select=self.navigation.select, name=self.status.labels["hover"].setText)
+                                 select=self.navigation.select, name=self.status.labels["hover"].setText,
+                                 measure=self.measuring.click)
         restore_layout(self, self.settings)
 
     def quit_unattended(self, discard: bool = False) -> None:
@@ -180,7 +186,7 @@ class MainWindow(QMainWindow):
                 add_dock(self, "Validation", scrolled(self.validation_panel)),
                 add_dock(self, "Ramachandran", scrolled(self.ramachandran_panel)),
                 add_dock(self, "Compare", self.comparison_panel), add_dock(self, "Map", scrolled(self.map_panel)),
-                add_dock(self, "History", self.history)]
+                add_dock(self, "Measurements", self.measurements_panel), add_dock(self, "History", self.history)]
         for dock in tabs[1:]:  # one group of tabs under the level controls: each gets the column's height
             self.tabifyDockWidget(tabs[0], dock)
         tabs[0].raise_()

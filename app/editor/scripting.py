@@ -16,6 +16,7 @@ import numpy as np
 
 from app.editor.features.export import export_view
 from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
+from core.protein.lookup import find_atom
 
 if TYPE_CHECKING:
     from app.editor.document import Document
@@ -114,6 +115,26 @@ class EditorAPI:
         segment. Returns their labels (ValueError for a residue that does not exist)."""
         document = self._document
         return [document.row_label(int(row)) for row in self._editor.navigation.go_to(residues)]
+
+    def measure(self, *atoms: int | str) -> float | None:
+        """Label one atom, or measure the distance of two, the angle of three or the dihedral of
+        four, as View ▸ Label Atom and the Measure tools do: atoms as coordinate rows or as
+        people name them (``'A:48 NZ'``, ``'/A:48@NZ'``, ``'A/48/NZ'``; in the edited chain
+        where none is named). Returns the value (Å or degrees; None for a label)."""
+        document = self._document
+        chain = document.structure.segments[document.segment].chain if document.editable else None
+        rows = [int(atom) if isinstance(atom, (int, np.integer)) else find_atom(document.structure, atom, chain)
+                for atom in atoms]
+        return document.measurements.add(rows, len(document.model.coords)).value(document.model.coords)
+
+    @property
+    def measurements(self) -> list[str]:
+        """Each label and measurement as the *Measurements* dock lists it, its value as the
+        model is now: ``'A:LYS48 NZ – A:GLU50 OE1: 3.21 Å'``."""
+        document = self._document
+        return [m.names(document.structure) + ("" if m.kind == "label" else
+                                                f": {m.text(document.structure, document.model.coords)}")
+                for m in document.measurements.items]
 
     def history(self) -> tuple[list[str], int]:
         """The names of the undo steps and the current position (steps done)."""

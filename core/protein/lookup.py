@@ -65,6 +65,44 @@ def find_residues(structure: Structure, text: str, chain: str | None = None) -> 
     return np.arange(low, high + 1)
 
 
+def find_atom(structure: Structure, text: str, chain: str | None = None) -> int:
+    """Coordinate row of the atom named by ``text``: one residue as :func:`find_residues` reads
+    it and an atom name, ``A:LYS48 NZ``, ``48 CA`` (in ``chain``), ``/A:48@NZ`` (ChimeraX),
+    ``A/48/NZ`` or ``chain A and resi 48 and name NZ`` (PyMOL); the first alternate location.
+    Raises ValueError naming what is missing or how to type it."""
+    residue, name = _atom_parts(text.strip())
+    if not name:
+        raise ValueError(f"cannot read {text.strip()!r} as an atom: type e.g. A:48 NZ, /A:48@NZ or A/48/NZ")
+    rows = find_residues(structure, residue, chain)
+    if len(rows) != 1:
+        raise ValueError(f"{text.strip()!r} names {len(rows)} residues: name one, and an atom of it")
+    atoms = np.flatnonzero((structure.atom_residue == rows[0]) & (structure.atoms.name == name.upper()))
+    if not len(atoms):
+        raise ValueError(f"no atom {name.upper()} in {_label(structure, int(rows[0]))}")
+    return int(atoms[0])
+
+
+def _atom_parts(text: str) -> tuple[str, str]:
+    """A residue's text and an atom's name, as the syntax of ``text`` splits them ('' for no atom)."""
+    terms = re.split(r"\s+and\s+|\s*&\s*", text, flags=re.IGNORECASE)
+    names = [term for term in terms if term.lower().startswith(("name ", "n. "))]
+    if len(terms) > 1 and len(names) == 1:
+        return " and ".join(term for term in terms if term not in names), names[0].split()[-1]
+    if "@" in text:
+        residue, _, name = text.rpartition("@")
+        return residue, name.strip()
+    if "/" in text and ":" not in text:
+        residue, _, name = text.rpartition("/")
+        return residue + "/", name.strip()
+    match = re.fullmatch(r"(.+?)\s+([A-Za-z0-9'*]{1,4})", text)
+    return (match[1], match[2]) if match else (text, "")
+
+
+def _label(structure: Structure, row: int) -> str:
+    segment = next(s for s in structure.segments if s.residue_index[0] <= row <= s.residue_index[-1])
+    return str(segment.labels[row - segment.residue_index[0]])
+
+
 def _read(text: str) -> _Named | None:
     """``text`` read in the first syntax that reads it whole, or None."""
     if match := _OWN.fullmatch(text):

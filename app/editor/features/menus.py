@@ -16,7 +16,7 @@ from PySide6.QtWidgets import QMainWindow, QMenu, QWidget
 MENUS = {
     "&File": ("open", "save", "session", "quit"),
     "&Edit": ("undo", "mode", "region", "fit"),
-    "&View": ("camera", "docks", "console"),
+    "&View": ("camera", "measure", "docks", "console"),
     "&Help": ("help",),
 }
 """Each menu's sections, top to bottom."""

@@ -145,7 +145,8 @@ class Sessions:
                     for item in self.comparison.items]
         camera = [list(map(float, vector)) for vector in self.plotter.camera_position]
         return session.View(sorted(layer.name for layer in self.scene.layers), self.scene.colouring.value,
-                            self.scene.fat_helices, camera, compared, self.scene.helix_cylinders)
+                            self.scene.fat_helices, camera, compared, self.scene.helix_cylinders,
+                            [list(m.atoms) for m in self.document.measurements.items])
 
     def _apply_view(self, view: session.View) -> None:
         for layer, box in self.display_panel.layer_boxes.items():
@@ -154,6 +155,13 @@ class Sessions:
         panel.colouring.setCurrentIndex(max(panel.colouring.findData(Colouring(view.colouring)), 0))
         panel.fat.setChecked(view.fat_helices)
         panel.cylinders.setChecked(view.helix_cylinders)
+        measurements = self.document.measurements
+        measurements.replace([])
+        for atoms in view.measurements:
+            try:
+                measurements.add(atoms, len(self.document.model.coords))
+            except (TypeError, ValueError) as error:  # a session written by hand, or damaged
+                self.window.statusBar().showMessage(f"a measurement of the session left out: {error}", 15000)
         for item in view.compared:
             try:
                 self.comparison.add(item.path, item.chain, item.source)

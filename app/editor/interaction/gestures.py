@@ -31,17 +31,20 @@ if TYPE_CHECKING:
 
 
 class Gestures:
-    """Routes ``plotter``'s pointer events to ``controller`` and the camera; a click selects
-    (``select``, residue-table rows) and the hover is named (``name``, '' for nothing)."""
+    """Routes ``plotter``'s pointer events to ``controller`` and the camera; a click goes to
+    ``measure`` (what is under it; True when a measuring tool took it) or selects (``select``,
+    residue-table rows), and the hover is named (``name``, '' for nothing)."""
 
     def __init__(self, document: Document, plotter: View, scene: Scene, controller: DragController, *,
-                 select: Callable[[Sequence[int]], None], name: Callable[[str], None]) -> None:
+                 select: Callable[[Sequence[int]], None], name: Callable[[str], None],
+                 measure: Callable[[Hit | None], bool] = lambda hit: False) -> None:
         self.document = document
         self.plotter = plotter
         self.scene = scene
         self.controller = controller
         self.select = select
         self.name = name
+        self.measure = measure
         self.pointer = PointerAdapter(plotter, self._on_pointer)
         self._press_at: tuple[int, int] | None = None  # where a press the camera took began (display pixels)
         self._hovered: tuple | None = None  # what the hover names now
@@ -111,8 +114,11 @@ class Gestures:
             QToolTip.showText(QCursor.pos(), text, self.plotter)
 
     def _click(self, event: PointerEvent) -> None:
-        """A click that no drag took: select the residue under the pointer."""
+        """A click that no drag took: an atom for the measuring tool in use, else select the
+        residue under the pointer."""
         hit = self._hit(event)
+        if self.measure(hit):
+            return
         if hit is not None and hit.row >= 0 and hit.kind != "point":
             self.select([hit.row])
 

@@ -9,7 +9,7 @@ record format of journals (:mod:`app.editor.persistence.records`), written atomi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -44,11 +44,13 @@ class View:
     camera: list[list[float]]
     compared: list[ComparedFile]
     helix_cylinders: bool = False
+    measurements: list[list[int]] = field(default_factory=list)
+    """The atoms (coordinate rows) of each label and measurement."""
 
     def record(self) -> records.Record:
         """The ``view`` record of this view."""
         fields = {"layers": self.layers, "colouring": self.colouring, "fat_helices": self.fat_helices,
-                  "helix_cylinders": self.helix_cylinders, "camera": self.camera,
+                  "helix_cylinders": self.helix_cylinders, "measurements": self.measurements, "camera": self.camera,
                   "compared": [{"path": str(c.path), "chain": c.chain, "visible": c.visible} for c in self.compared]}
         arrays = {f"compared_{k}": np.frombuffer(c.source, dtype=np.uint8) for k, c in enumerate(self.compared)}
         return records.Record("view", fields, arrays)
@@ -60,7 +62,7 @@ class View:
         compared = [ComparedFile(Path(c["path"]), record.arrays[f"compared_{k}"].tobytes(), c["chain"], c["visible"])
                     for k, c in enumerate(fields["compared"])]
         return cls(fields["layers"], fields["colouring"], fields["fat_helices"], fields["camera"], compared,
-                   fields.get("helix_cylinders", False))  # (not in sessions written before the cartoon)
+                   fields.get("helix_cylinders", False), fields.get("measurements", []))  # (newer than the format)
 
 
 def write(path: Path, recording: list[records.Record], view: View) -> None:

@@ -29,6 +29,7 @@ from app.editor.scene.layers.chains import DIM_ABOVE_CHAINS, Chains, Others, fad
 from app.editor.scene.layers.control_points import ControlPointsLayer
 from app.editor.scene.layers.level_curve import CurveLayer
 from app.editor.scene.layers.ligands import IonsLayer, LigandsLayer
+from app.editor.scene.layers.measurements import MeasurementsLayer
 from app.editor.scene.layers.nucleic import NucleicLayer
 from app.editor.scene.layers.selection import SelectionLayer
 from app.editor.scene.layers.tube import TubeLayer
@@ -48,10 +49,11 @@ LAYERS: tuple[type[SceneLayer], ...] = (
     NucleicLayer,
     LigandsLayer,
     IonsLayer,
+    MeasurementsLayer,
 )
 """The layers every scene draws, in this order (the validation markers add themselves)."""
 DEFAULT_LAYERS = {Layer.CARTOON, Layer.CURVE, Layer.CONTROL_POINTS, Layer.NUCLEIC, Layer.LIGANDS, Layer.IONS,
-                  Layer.VALIDATION}
+                  Layer.VALIDATION, Layer.MEASUREMENTS}
 STILL_AFTER_MS = 250
 """Full detail comes back once nothing has moved for this long."""
 CAPTION_COLOUR = "#2b2f36"

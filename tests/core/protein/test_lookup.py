@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.protein.lookup import find_residues
+from core.protein.lookup import find_atom, find_residues
 from core.protein.reading import read_structure
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -74,3 +74,22 @@ def test_clear_messages(haemoglobin, text: str, message: str) -> None:
 def test_one_letter_sequence() -> None:
     ubiquitin = read_structure(DATA / "1UBQ.pdb.gz")
     assert ubiquitin.segments[0].sequence == "MQIFVKTLTGKTITLEVEPSDTIENVKAKIQDKEGIPPDQQRLIFAGKQLEDGRTLSDYNIQKESTLHLVLRLRGG"
+
+
+@pytest.mark.parametrize(("text", "chain", "atom"), [
+    ("A:45 CA", None, "A:HIS45 CA"), ("45 NE2", "A", "A:HIS45 NE2"), ("/B:45@CB", None, "B:PHE45 CB"),
+    ("B/45/CB", "A", "B:PHE45 CB"), ("/4hhb//C/45/N", None, "C:HIS45 N"),
+    ("chain D and resi 45 and name CA", None, "D:PHE45 CA"), ("resi 45 & n. CA", "C", "C:HIS45 CA"),
+])
+def test_atoms_named_as_people_type_them(haemoglobin, text: str, chain: str | None, atom: str) -> None:
+    row = find_atom(haemoglobin, text, chain)
+    assert f"{_label(haemoglobin, int(haemoglobin.atom_residue[row]))} {haemoglobin.atoms.name[row]}" == atom
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("A:45", "cannot read 'A:45' as an atom"), ("A:45 XX", "no atom XX in A:HIS45"),
+    ("A:40-45 CA", "names 6 residues"), ("Z:45 CA", "no chain Z"),
+])
+def test_atoms_that_are_not_there_are_said_so(haemoglobin, text: str, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        find_atom(haemoglobin, text)

@@ -43,6 +43,7 @@ class Layer(StrEnum):
     LIGANDS = "ligands"
     IONS = "ions"
     VALIDATION = "validation markers"
+    MEASUREMENTS = "measurements"
 
 
 class Stage(Protocol):

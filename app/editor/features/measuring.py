@@ -1,0 +1,71 @@
+"""Labels and measurements picked with the mouse: *View ▸ Label Atom*, *Measure Distance*,
+*Measure Angle* or *Measure Dihedral* makes the next clicks in the view pick atoms (a residue
+clicked where no atom is drawn gives its Cα) until there are enough; Esc or the same entry
+again stops. They are listed in the *Measurements* dock and drawn in the view
+(:mod:`app.editor.scene.layers.measurements`)."""
+
+from __future__ import annotations
+
+from PySide6.QtGui import QActionGroup, QKeySequence
+from PySide6.QtWidgets import QMainWindow
+
+from app.editor.document import Document
+from app.editor.features.menus import Menus
+from app.editor.interaction.identify import Hit
+from app.editor.measurements import KINDS
+
+TOOLS = {1: ("&Label Atom", "Ctrl+Shift+L"), 2: ("Measure &Distance", "Ctrl+Shift+D"),
+         3: ("Measure &Angle", "Ctrl+Shift+A"), 4: ("Measure Di&hedral", "Ctrl+Shift+H")}
+"""Each tool's entry and shortcut, by the atoms it picks."""
+
+
+class Measuring:
+    """The tools that pick atoms for a label or a measurement."""
+
+    def __init__(self, window: QMainWindow, document: Document, menus: Menus) -> None:
+        self.window = window
+        self.document = document
+        self.wanted = 0
+        """Atoms the tool in use picks (0: none in use)."""
+        self.picked: list[int] = []
+        self.tools = QActionGroup(window)
+        self.tools.setExclusionPolicy(QActionGroup.ExclusionPolicy.ExclusiveOptional)
+        for count, (text, key) in TOOLS.items():
+            action = menus.action(text, QKeySequence(key), lambda on, count=count: self.use(count if on else 0))
+            action.setCheckable(True)
+            self.tools.addAction(action)
+        self.clear_action = menus.action("Clear Measurements", QKeySequence(),
+                                         lambda: document.measurements.replace([]))
+        menus.add("measure", *self.tools.actions(), self.clear_action)
+        document.loaded.connect(lambda: self.use(0))
+
+    def use(self, count: int) -> None:
+        """Pick ``count`` atoms with the next clicks (0: stop)."""
+        self.wanted, self.picked = count, []
+        for action in self.tools.actions():
+            action.setChecked(TOOLS.get(count, ("",))[0] == action.text())
+        self._say()
+
+    def click(self, hit: Hit | None) -> bool:
+        """A click in the view while a tool is in use picks the atom under it (a residue's Cα);
+        returns whether the click was the tool's."""
+        if not self.wanted:
+            return False
+        if hit is not None and hit.kind in ("atom", "residue"):
+            row = hit.index if hit.kind == "atom" else int(self.document.ca_rows[hit.row])
+            if row not in self.picked:
+                self.picked.append(row)
+            if len(self.picked) == self.wanted:
+                self.document.measurements.add(self.picked, len(self.document.model.coords))
+                self.picked = []
+        self._say()
+        return True
+
+    def _say(self) -> None:
+        if self.wanted:
+            what = KINDS[self.wanted]
+            self.window.statusBar().showMessage(
+                f"{what.capitalize()}: click atom {len(self.picked) + 1} of {self.wanted} (Esc stops)"
+                if self.wanted > 1 else "Label: click an atom (Esc stops)")
+        else:
+            self.window.statusBar().clearMessage()

@@ -1,0 +1,96 @@
+"""Labels and measurements in the view (:mod:`app.editor.measurements`): a line through each
+measurement's atoms (``measure_lines``) and its value, or a label's atom name, as text that
+faces the camera beside it; rewritten in place when an edit moves their atoms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+from vtkmodules.vtkRenderingCore import vtkBillboardTextActor3D
+
+from app.editor.document import Change
+from app.editor.measurements import Measurement
+from app.editor.scene.layers.base import Layer, SceneLayer, Stage
+from app.editor.scene.layers.meshes import polylines
+
+COLOUR = (20, 110, 150)
+"""The lines' and the texts' colour."""
+TEXT_PIXELS = 15
+LABEL_OFFSET = 0.6
+"""Å a label's text stands off its atom."""
+
+
+class MeasurementsLayer(SceneLayer):
+    """Every label and measurement of the document, drawn over the structure."""
+
+    switch = Layer.MEASUREMENTS
+    needs_backbone = False
+    names = ("measure_lines",)
+    lines_as_tubes = ("measure_lines",)
+
+    def __init__(self, scene: Stage) -> None:
+        super().__init__(scene)
+        self._texts: list[vtkBillboardTextActor3D] = []
+        self._rows = np.empty(0, dtype=np.int64)
+        self.document.measurements.changed.connect(self._changed)
+
+    def build(self) -> None:
+        items = self.document.measurements.items
+        coords = self.document.model.coords
+        self._rows = np.array([row for m in items for row in m.atoms], dtype=np.int64)
+        bounds = np.cumsum([0] + [len(m.atoms) for m in items])
+        self.meshes["measure_lines"] = (pv.PolyData(coords[self._rows].copy(), lines=polylines(bounds))
+                                        if len(self._rows) else pv.PolyData())
+        self.add("measure_lines", color=COLOUR, line_width=3.0, render_lines_as_tubes=True)
+        self._texts = []
+        for k, measurement in enumerate(items):
+            text = vtkBillboardTextActor3D()
+            style = text.GetTextProperty()
+            style.SetFontSize(TEXT_PIXELS)
+            style.SetBold(True)
+            style.SetColor(*(c / 255 for c in COLOUR))
+            style.SetJustificationToCentered()
+            self._texts.append(text)
+            self.actors[f"measure_text_{k}"] = text
+            self.scene.plotter.add_actor(text, name=f"measure_text_{k}", reset_camera=False, render=False,
+                                         pickable=False)
+            self._place(text, measurement, coords)
+        self.show(self.visible)
+
+    def update(self, change: Change) -> None:
+        if len(self._rows) and np.isin(self._rows, change.rows).any():
+            coords = self.document.model.coords
+            self.write("measure_lines", slice(None), coords[self._rows])
+            for text, measurement in zip(self._texts, self.document.measurements.items):
+                self._place(text, measurement, coords)
+
+    def show(self, visible: bool) -> None:
+        super().show(visible)
+        for text in self._texts:
+            text.SetVisibility(visible)
+
+    def _place(self, text: vtkBillboardTextActor3D, measurement: Measurement, coords: np.ndarray) -> None:
+        """Put ``measurement``'s text where it belongs: beside a label's atom, at the middle of
+        a distance, at an angle's vertex, at the middle of a dihedral's axis."""
+        xyz = coords[list(measurement.atoms)]
+        if len(xyz) == 1:
+            where = xyz[0] + LABEL_OFFSET
+        elif len(xyz) == 3:
+            where = xyz[1]
+        else:  # the middle of a distance, of a dihedral's axis
+            where = xyz[len(xyz) // 2 - 1:len(xyz) // 2 + 1].mean(axis=0)
+        text.SetPosition(*where)
+        text.SetInput(measurement.text(self.document.structure, coords))
+
+    def _changed(self) -> None:
+        """A measurement was added or removed: drawn again (once the structure is drawn)."""
+        if "measure_lines" not in self.meshes or self.document.model is None:
+            return
+        plotter = self.scene.plotter
+        for k in range(len(self._texts)):
+            plotter.remove_actor(f"measure_text_{k}", render=False)
+            self.actors.pop(f"measure_text_{k}", None)
+        plotter.remove_actor("measure_lines", render=False)
+        self.actors.pop("measure_lines", None)
+        self.build()
+        plotter.render()

@@ -1,0 +1,108 @@
+"""Labels and measurements (#34): atoms picked with the mouse or named from ``rw``, drawn in the
+view and listed in their dock, their values following a drag, kept in sessions; values as
+gemmi computes them."""
+
+from collections.abc import Callable
+from pathlib import Path
+
+import gemmi
+import numpy as np
+import pytest
+from PySide6.QtCore import Qt
+from pytestqt.qtbot import QtBot
+
+from app.editor.main_window import MainWindow
+from app.editor.scene.layers.base import Layer
+
+Opener = Callable[[str], MainWindow]
+
+
+def _display(window: MainWindow, point: np.ndarray) -> tuple[int, int]:
+    renderer = window.plotter.renderer
+    renderer.SetWorldPoint(*point, 1.0)
+    renderer.WorldToDisplay()
+    x, y, _ = renderer.GetDisplayPoint()
+    return round(x), round(y)
+
+
+def _click(window: MainWindow, point: np.ndarray) -> None:
+    """A left click at ``point`` (Å) on the view's VTK interactor, as the mouse gives it."""
+    interactor = window.plotter.iren.interactor
+    interactor.SetEventInformation(*_display(window, point))
+    interactor.InvokeEvent("LeftButtonPressEvent")
+    interactor.InvokeEvent("LeftButtonReleaseEvent")
+
+
+def _position(coords: np.ndarray, row: int) -> gemmi.Position:
+    return gemmi.Position(*map(float, coords[row]))
+
+
+def _texts(window: MainWindow) -> list[str]:
+    return [actor.GetInput() for name, actor in window.scene.actors.items() if name.startswith("measure_text_")]
+
+
+def test_a_distance_picked_with_the_mouse_follows_a_drag(open_window: Opener, qtbot: QtBot) -> None:
+    window = open_window("1UBQ.pdb.gz")
+    document = window.document
+    document.set_regularization(on_release=False)
+    window.display_panel.layer_boxes[Layer.ATOMS].setChecked(True)
+    window.display_panel.layer_boxes[Layer.CONTROL_POINTS].setChecked(False)  # (no sphere in front of an atom)
+    names = document.structure.atoms.name
+    first = int(np.flatnonzero((document.structure.atom_residue == 47) & (names == "NZ"))[0])  # Lys48 NZ
+    second = int(np.flatnonzero((document.structure.atom_residue == 5) & (names == "NZ"))[0])  # Lys6 NZ
+    window.measuring.tools.actions()[1].trigger()  # View ▸ Measure Distance
+    assert window.statusBar().currentMessage() == "Distance: click atom 1 of 2 (Esc stops)"
+    _click(window, document.model.coords[first])
+    assert window.statusBar().currentMessage() == "Distance: click atom 2 of 2 (Esc stops)"
+    _click(window, document.model.coords[second])
+    items = document.measurements.items
+    assert len(items) == 1 and items[0].atoms == (first, second) and len(document.selection) == 0
+    expected = _position(document.model.coords, first).dist(_position(document.model.coords, second))
+    table = window.measurements_panel.table
+    assert table.rowCount() == 1 and table.item(0, 1).text() == "A:LYS48 NZ – A:LYS6 NZ"
+    assert table.item(0, 2).text() == _texts(window)[0] == f"{expected:.2f} Å"
+
+    window.rw.tug(47, (3.0, 0.0, 0.0))  # Lys48 moves: the value follows in the view and the dock
+    moved = _position(document.model.coords, first).dist(_position(document.model.coords, second))
+    assert abs(moved - expected) > 0.5
+    assert table.item(0, 2).text() == _texts(window)[0] == f"{moved:.2f} Å"
+    lines = np.asarray(window.scene.meshes["measure_lines"].points)
+    np.testing.assert_allclose(lines, document.model.coords[[first, second]], atol=1e-4)
+    window.rw.undo()
+    assert table.item(0, 2).text() == f"{expected:.2f} Å"
+
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow)
+    qtbot.keyClick(window.plotter, Qt.Key.Key_Escape)  # the tool stops: a click selects again
+    assert window.measuring.wanted == 0
+    _click(window, document.model.coords[first])
+    assert len(document.measurements.items) == 1 and list(document.selection) == [47]
+
+
+def test_labels_angles_and_dihedrals_from_rw_are_gemmis_and_come_back_with_the_session(
+        open_window: Opener, tmp_path: Path) -> None:
+    window = open_window("4HHB.pdb.gz")
+    rw, document = window.rw, window.document
+    assert rw.measure("B:48 CA") is None  # a label
+    angle = rw.measure("A:45 N", "A:45 CA", "A:45 C")
+    phi = rw.measure("/A:44@C", "A/45/N", "chain A and resi 45 and name CA", "A:HIS45 C")
+    coords = document.model.coords
+    rows = [atoms for atoms in (m.atoms for m in document.measurements.items)]
+    p = [_position(coords, row) for row in rows[2]]
+    assert angle == pytest.approx(np.degrees(gemmi.calculate_angle(*[_position(coords, r) for r in rows[1]])))
+    assert phi == pytest.approx(np.degrees(gemmi.calculate_dihedral(*p)))
+    assert rw.measurements == ["B:LEU48 CA", f"A:HIS45 N – A:HIS45 CA – A:HIS45 C: {angle:.1f}°",
+                               f"A:PRO44 C – A:HIS45 N – A:HIS45 CA – A:HIS45 C: {phi:.1f}°"]
+    assert "B:LEU48 CA" in _texts(window)
+    with pytest.raises(ValueError, match="no atom XX in A:HIS45"):
+        rw.measure("A:45 XX", "A:45 CA")
+    with pytest.raises(ValueError, match="1 to 4 different atoms"):
+        rw.measure("A:45 CA", "A:45 CA")
+    saved = window.sessions.write_session(tmp_path / "measured")
+    window.measurements_panel.table.selectRow(0)
+    window.measurements_panel.delete.click()
+    assert len(rw.measurements) == 2
+    assert window.sessions.open_session(saved)
+    assert rw.measurements[0] == "B:LEU48 CA" and len(rw.measurements) == 3
+    rw.open(Path(__file__).resolve().parents[2] / "data" / "1UBQ.pdb.gz")  # another structure: none
+    assert rw.measurements == [] and window.measurements_panel.table.rowCount() == 0
