@@ -39,6 +39,7 @@ from app.editor.docks.sequence import SequenceBar
 from app.editor.docks.surfaces import SurfacePanel
 from app.editor.docks.validation import ValidationPanel
 from app.editor.document import Document
+from app.editor.features.clipping import Clipping
 from app.editor.features.editing import Editing
 from app.editor.features.export import ImageExport
 from app.editor.features.files import Files
@@ -90,6 +91,7 @@ class MainWindow(QMainWindow):
         self.controller = DragController(self.document)
         self.menus = Menus(self)
         self.navigation = Navigation(self, self.document, self.scene, self.plotter, self.menus)
+        self.clipping = Clipping(self, self.scene, self.plotter, self.menus)
 
         self.dimension_panel = RibbonDimensionPanel(self.document)
         self.dimension_panel.slider.valueChanged.connect(self.scene.moved)  # less detail while the level slides
@@ -110,7 +112,8 @@ class MainWindow(QMainWindow):
         self.map_panel = MapPanel(self.maps, self.correlation, self.maps_and_fits.fit_actions)
         self.export = ImageExport(self, self.plotter, self.files, self.menus)
         self.sessions = Sessions(self, self.document, self.journal, self.files, self.menus, plotter=self.plotter,
-                                 scene=self.scene, display_panel=self.display_panel, comparison=self.comparison)
+                                 scene=self.scene, display_panel=self.display_panel, comparison=self.comparison,
+                                 clipping=self.clipping)
         self.editing = Editing(self, self.document, self.controller, self.menus)
         self.measuring = Measuring(self, self.document, self.menus)
         self.editing.cancel_action.triggered.connect(lambda: self.measuring.use(0))  # Esc stops a tool too

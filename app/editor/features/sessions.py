@@ -24,6 +24,7 @@ from core.protein.structure import StructureError
 if TYPE_CHECKING:
     from app.editor.docks.panels import DisplayPanel
     from app.editor.document import Document
+    from app.editor.features.clipping import Clipping
     from app.editor.features.files import Files
     from app.editor.features.menus import Menus
     from app.editor.scene.overlay import Comparison
@@ -39,7 +40,7 @@ class Sessions:
 
     def __init__(self, window: QMainWindow, document: Document, journal: journal.Journal, files: Files,
                  menus: Menus, *, plotter: View, scene: Scene, display_panel: DisplayPanel,
-                 comparison: Comparison) -> None:
+                 comparison: Comparison, clipping: Clipping) -> None:
         self.window = window
         self.document = document
         self.journal = journal
@@ -48,6 +49,7 @@ class Sessions:
         self.scene = scene
         self.display_panel = display_panel
         self.comparison = comparison
+        self.clipping = clipping
         self.open_session_action = menus.action("Open Sess&ion…", QKeySequence("Ctrl+Shift+O"),
                                                 self._open_session_dialog)
         self.save_session_action = menus.action("Save Sessio&n…", QKeySequence("Ctrl+Alt+S"), self.save_session)
@@ -146,7 +148,8 @@ class Sessions:
         camera = [list(map(float, vector)) for vector in self.plotter.camera_position]
         return session.View(sorted(layer.name for layer in self.scene.layers), self.scene.colouring.value,
                             self.scene.fat_helices, camera, compared, self.scene.helix_cylinders,
-                            [list(m.atoms) for m in self.document.measurements.items])
+                            [list(m.atoms) for m in self.document.measurements.items],
+                            None if self.scene.slab is None else list(self.scene.slab))
 
     def _apply_view(self, view: session.View) -> None:
         for layer, box in self.display_panel.layer_boxes.items():
@@ -155,6 +158,7 @@ class Sessions:
         panel.colouring.setCurrentIndex(max(panel.colouring.findData(Colouring(view.colouring)), 0))
         panel.fat.setChecked(view.fat_helices)
         panel.cylinders.setChecked(view.helix_cylinders)
+        self.clipping.set(None if view.slab is None else (view.slab[0], view.slab[1]))
         measurements = self.document.measurements
         measurements.replace([])
         for atoms in view.measurements:

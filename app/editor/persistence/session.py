@@ -46,11 +46,14 @@ class View:
     helix_cylinders: bool = False
     measurements: list[list[int]] = field(default_factory=list)
     """The atoms (coordinate rows) of each label and measurement."""
+    slab: list[float] | None = None
+    """The clipping slab (Å in front of and behind the centre), or None."""
 
     def record(self) -> records.Record:
         """The ``view`` record of this view."""
         fields = {"layers": self.layers, "colouring": self.colouring, "fat_helices": self.fat_helices,
-                  "helix_cylinders": self.helix_cylinders, "measurements": self.measurements, "camera": self.camera,
+                  "helix_cylinders": self.helix_cylinders, "measurements": self.measurements, "slab": self.slab,
+                  "camera": self.camera,
                   "compared": [{"path": str(c.path), "chain": c.chain, "visible": c.visible} for c in self.compared]}
         arrays = {f"compared_{k}": np.frombuffer(c.source, dtype=np.uint8) for k, c in enumerate(self.compared)}
         return records.Record("view", fields, arrays)
@@ -62,7 +65,15 @@ class View:
         compared = [ComparedFile(Path(c["path"]), record.arrays[f"compared_{k}"].tobytes(), c["chain"], c["visible"])
                     for k, c in enumerate(fields["compared"])]
         return cls(fields["layers"], fields["colouring"], fields["fat_helices"], fields["camera"], compared,
-                   fields.get("helix_cylinders", False), fields.get("measurements", []))  # (newer than the format)
+                   fields.get("helix_cylinders", False), fields.get("measurements", []),
+                   _slab(fields.get("slab")))  # (these three are newer than the format)
+
+
+def _slab(value: object) -> list[float] | None:
+    """A session's slab, two positive distances (Å), or None (also for anything else)."""
+    if isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) and 0 < v < 1e4 for v in value):
+        return [float(v) for v in value]
+    return None
 
 
 def write(path: Path, recording: list[records.Record], view: View) -> None:

@@ -54,6 +54,8 @@ LAYERS: tuple[type[SceneLayer], ...] = (
 """The layers every scene draws, in this order (the validation markers add themselves)."""
 DEFAULT_LAYERS = {Layer.CARTOON, Layer.CURVE, Layer.CONTROL_POINTS, Layer.NUCLEIC, Layer.LIGANDS, Layer.IONS,
                   Layer.VALIDATION, Layer.MEASUREMENTS}
+MIN_SLAB = 0.5
+"""Å: the nearest a clipping plane comes to the centre of the view."""
 STILL_AFTER_MS = 250
 """Full detail comes back once nothing has moved for this long."""
 CAPTION_COLOUR = "#2b2f36"
@@ -76,6 +78,9 @@ class Scene(QObject):
         self.fat_helices = False
         self.helix_cylinders = False
         self.others = Others.SHOWN
+        self.slab: tuple[float, float] | None = None
+        """The clipping slab: how far (Å) its near and far planes lie in front of and behind the
+        centre of the view (the camera's focal point), or None (nothing clipped)."""
         self.chains: Chains
         """The residues' chains (set when an editable structure is built)."""
         self.meshes: dict[str, pv.PolyData] = {}
@@ -142,6 +147,14 @@ class Scene(QObject):
         if self.document.editable:
             self._draw_others()
             self.plotter.render()
+
+    def set_slab(self, slab: tuple[float, float] | None) -> None:
+        """Clip the view to a slab about its centre (see :attr:`slab`; each plane at least
+        :data:`MIN_SLAB` Å from the centre), or not."""
+        self.slab = None if slab is None else (max(float(slab[0]), MIN_SLAB), max(float(slab[1]), MIN_SLAB))
+        if slab is None:
+            self.plotter.renderer.ResetCameraClippingRange()  # everything, as before
+        self.plotter.render()
 
     def moved(self) -> None:
         """Something moves (the camera, a dragged point, the level slider): draw with less
@@ -242,6 +255,7 @@ class Scene(QObject):
         self.meshes.clear()
         self.actors.clear()
         self.others = Others.SHOWN
+        self.slab = None
         self._concealed = False
         self.still(render=False)
         if editable:
@@ -328,6 +342,10 @@ class Scene(QObject):
             layer.set_detail(full)
 
     def _before_frame(self) -> None:
+        if self.slab is not None:  # (after the camera style's own reset of the clipping range)
+            camera = self.plotter.renderer.GetActiveCamera()
+            distance = camera.GetDistance()
+            camera.SetClippingRange(max(distance - self.slab[0], 0.01 * distance), distance + self.slab[1])
         for layer in self._drawn:
             layer.before_frame()
 
