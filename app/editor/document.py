@@ -104,6 +104,9 @@ class Document(QObject):
         self._preview: Edit | None = None
         self.measurements = Measurements(self)
         """Labels and measurements on atoms (cleared with a new structure)."""
+        self.kept_view = False
+        """Whether the structure last loaded is another model of the same file, shown as the
+        one before it was (the camera and the slab stay)."""
 
     # ------------------------------------------------------------------ state
 
@@ -397,6 +400,7 @@ class Document(QObject):
         self.selection = np.empty(0, dtype=np.int64)
         self._preview = None
         self._curves.clear()
+        self.kept_view = keep_view
         self.loaded.emit()
 
     def _preview_edit(self, plan: Callable[[], Edit]) -> None:

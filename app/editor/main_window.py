@@ -47,6 +47,7 @@ from app.editor.features.help import Help
 from app.editor.features.maps import MapsAndFits
 from app.editor.features.measuring import Measuring
 from app.editor.features.menus import Menus
+from app.editor.features.models import Models
 from app.editor.features.navigation import Navigation
 from app.editor.features.sessions import Sessions
 from app.editor.interaction.drag import DragController
@@ -92,6 +93,7 @@ class MainWindow(QMainWindow):
         self.menus = Menus(self)
         self.navigation = Navigation(self, self.document, self.scene, self.plotter, self.menus)
         self.clipping = Clipping(self, self.scene, self.plotter, self.menus)
+        self.models = Models(self, self.document, self.menus)
 
         self.dimension_panel = RibbonDimensionPanel(self.document)
         self.dimension_panel.slider.valueChanged.connect(self.scene.moved)  # less detail while the level slides

@@ -35,7 +35,7 @@ class Clipping:
         thicker = menus.action("Thicker Slab", QKeySequence("Ctrl+Alt+Up"), lambda: self.widen(STEP, STEP))
         thinner = menus.action("Thinner Slab", QKeySequence("Ctrl+Alt+Down"), lambda: self.widen(-STEP, -STEP))
         menus.add("camera", self.toggle_action, thicker, thinner)
-        scene.document.loaded.connect(lambda: self.toggle_action.setChecked(False))  # (a new structure: no slab)
+        scene.document.loaded.connect(lambda: self.toggle_action.setChecked(scene.slab is not None))  # (after the scene)
         self._drag: tuple[int, int, tuple[float, float]] | None = None  # where it began, and the slab then
         self._tags: dict[str, int] = {}
         interactor = plotter.iren.interactor

@@ -30,6 +30,7 @@ from app.editor.scene.layers.control_points import ControlPointsLayer
 from app.editor.scene.layers.level_curve import CurveLayer
 from app.editor.scene.layers.ligands import IonsLayer, LigandsLayer
 from app.editor.scene.layers.measurements import MeasurementsLayer
+from app.editor.scene.layers.models import ModelsLayer
 from app.editor.scene.layers.nucleic import NucleicLayer
 from app.editor.scene.layers.selection import SelectionLayer
 from app.editor.scene.layers.tube import TubeLayer
@@ -47,13 +48,14 @@ LAYERS: tuple[type[SceneLayer], ...] = (
     SelectionLayer,
     AtomsLayer,
     NucleicLayer,
+    ModelsLayer,
     LigandsLayer,
     IonsLayer,
     MeasurementsLayer,
 )
 """The layers every scene draws, in this order (the validation markers add themselves)."""
 DEFAULT_LAYERS = {Layer.CARTOON, Layer.CURVE, Layer.CONTROL_POINTS, Layer.NUCLEIC, Layer.LIGANDS, Layer.IONS,
-                  Layer.VALIDATION, Layer.MEASUREMENTS}
+                  Layer.VALIDATION, Layer.MEASUREMENTS, Layer.MODELS}
 MIN_SLAB = 0.5
 """Å: the nearest a clipping plane comes to the centre of the view."""
 STILL_AFTER_MS = 250
@@ -255,7 +257,8 @@ class Scene(QObject):
         self.meshes.clear()
         self.actors.clear()
         self.others = Others.SHOWN
-        self.slab = None
+        kept = self.document.kept_view  # another model of the file: the same camera and slab
+        self.slab = self.slab if kept else None
         self._concealed = False
         self.still(render=False)
         if editable:
@@ -269,7 +272,8 @@ class Scene(QObject):
         self._update_caption()
         if self.others is not Others.SHOWN:
             self._draw_others()
-        self.reset_camera()
+        if not kept:
+            self.reset_camera()
         self.plotter.render()
 
     def _on_change(self, change: Change) -> None:

@@ -40,6 +40,7 @@ class Layer(StrEnum):
     CA_TRACE = "Cα trace"
     ATOMS = "atoms"
     NUCLEIC = "nucleic acids"
+    MODELS = "other models"
     LIGANDS = "ligands"
     IONS = "ions"
     VALIDATION = "validation markers"
