@@ -6,7 +6,9 @@ selected ones framed in the selection's colour. With a map open, a thin bar over
 gives the residue's correlation with the map (red 0.3 or less, through yellow, to green 0.8
 or more; grey where it has none). A click (or a drag across cells) asks for
 those residues to be selected and centred (:attr:`SequenceBar.residuesActivated`, which the
-window connects); Shift extends the selection. Hovering names the residue.
+window connects); Shift extends the selection. Hovering names the residue. After them come
+the letters of the entry's DNA and RNA strands, each on its base's colour and headed by its
+chain (drawn, not edited: nothing to select).
 """
 
 from __future__ import annotations
@@ -20,8 +22,11 @@ from app.editor.document import Document
 from app.editor.scene.layers.control_points import PICKED_COLOUR
 from app.editor.scene.layers.selection import SELECTION_COLOUR
 from app.editor.scene.molecule import SS_COLOURS, SS_NAMES
+from app.editor.scene.nucleic import nucleotides
 
 NUMBER_EVERY = 10
+STRAND_GAP = 2
+"""Empty cells before each DNA or RNA strand."""
 
 
 class SequenceStrip(QWidget):
@@ -42,14 +47,18 @@ class SequenceStrip(QWidget):
         self.row_height = metrics.height() + 4
         self.setMouseTracking(True)
         self._anchor: int | None = None
+        self._strands: list[tuple[str, str, np.ndarray]] = []
+        """Each nucleic-acid strand's chain, letters and colours."""
         self.scores: np.ndarray | None = None
         """Each residue's correlation with the map (NaN where none), or None without a map."""
-        for signal in (document.loaded, document.segmentChanged, document.picked, document.selectionChanged):
+        for signal in (document.segmentChanged, document.picked, document.selectionChanged):
             signal.connect(self._refresh)
-        self._refresh()
+        document.loaded.connect(self._loaded)
+        self._loaded()
 
     def sizeHint(self) -> QSize:
-        return QSize(self._count() * self.cell + 8, 2 * self.row_height + 6)
+        strands = sum(len(letters) + STRAND_GAP for _, letters, _ in self._strands)
+        return QSize((self._count() + strands) * self.cell + 8, 2 * self.row_height + 6)
 
     def minimumSizeHint(self) -> QSize:
         return self.sizeHint()
@@ -72,12 +81,21 @@ class SequenceStrip(QWidget):
         document = self.document
         return len(document.structure.segments[document.segment]) if document.editable else 0
 
+    def _loaded(self) -> None:
+        found = nucleotides(self.document.structure.atoms) if self.document.model is not None else None
+        self._strands = [] if found is None else [
+            (str(found.chain[a]), "".join(str(self.document.structure.atoms.resname[row]).strip()[-1:]
+                                          for row in found.backbone[a:b]), found.colours[a:b])
+            for a, b in zip(found.strand_start[:-1], found.strand_start[1:])]
+        self._refresh()
+
     def _refresh(self) -> None:
         self.setMinimumSize(self.sizeHint())
         self.resize(self.sizeHint())
         self.update()
 
     def paintEvent(self, event: QPaintEvent) -> None:
+        self._paint_strands()
         document = self.document
         if not document.editable:
             return
@@ -136,6 +154,25 @@ class SequenceStrip(QWidget):
         start = int(self.document.structure.segments[self.document.segment].residue_index[0])
         low, high = sorted((a, b))
         self.residuesActivated.emit(np.arange(start + low, start + high + 1))
+
+
+    def _paint_strands(self) -> None:
+        """The DNA and RNA strands' letters after the segment's, each headed by its chain."""
+        if not self._strands:
+            return
+        painter = QPainter(self)
+        text = self.palette().windowText().color()
+        k = self._count()
+        for chain, letters, colours in self._strands:
+            k += STRAND_GAP
+            painter.setPen(text)
+            painter.drawText(QPoint(self.cell_rect(k).left(), self.row_height - 2), f"{chain} (nucleic acid)")
+            for letter, colour in zip(letters, colours):
+                cell = self.cell_rect(k)
+                painter.fillRect(cell, QColor(*_light(tuple(int(c) for c in colour))))
+                painter.drawText(cell, Qt.AlignmentFlag.AlignCenter, letter)
+                k += 1
+        painter.end()
 
 
 class SequenceBar(QScrollArea):

@@ -5,6 +5,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from app.editor.docks.sequence import STRAND_GAP, _light
 from app.editor.main_window import MainWindow
 from app.editor.scene import nucleic
 from app.editor.scene.layers.base import Layer
@@ -51,3 +52,14 @@ def test_dna_beside_an_edited_protein_stays_where_it_is_and_hides_with_the_other
     assert np.ptp(hidden, axis=0).max() == 0.0
     scene.set_others(Others.SHOWN)
     np.testing.assert_array_equal(np.array(scene.meshes["nucleic_tube"].points), tube)
+
+
+def test_the_sequence_bar_shows_the_strands_letters_on_their_bases_colours(open_window: Opener) -> None:
+    window = open_window("1BNA.pdb.gz")
+    strip = window.sequence_bar.strip
+    assert [(chain, letters) for chain, letters, _ in strip._strands] == [("A", "CGCGAATTCGCG"), ("B", "CGCGAATTCGCG")]
+    image = strip.grab().toImage()
+    cell = strip.cell_rect(STRAND_GAP)  # the first strand's first letter, a C
+    colour = image.pixelColor(cell.left() + 2, cell.top() + 2)
+    assert (colour.red(), colour.green(), colour.blue()) == _light(nucleic.BASE_COLOURS["C"])
+    assert strip.sizeHint().width() >= (2 * (12 + STRAND_GAP)) * strip.cell
