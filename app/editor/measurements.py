@@ -19,9 +19,11 @@ KINDS = {1: "label", 2: "distance", 3: "angle", 4: "dihedral"}
 
 @dataclass(frozen=True)
 class Measurement:
-    """Atoms (coordinate rows, in order) and what they measure (:data:`KINDS`)."""
+    """Atoms (coordinate rows, in order) and what they measure (:data:`KINDS`); a label of one
+    atom names it, or with ``residue`` its residue (the atom is its Cα)."""
 
     atoms: tuple[int, ...]
+    residue: bool = False
 
     @property
     def kind(self) -> str:
@@ -43,7 +45,13 @@ class Measurement:
     def names(self, structure: Structure) -> str:
         """The atoms' names, joined by dashes: ``A:LYS48 NZ – A:GLU50 OE1``."""
         labels = topology(structure).atom_labels
+        if self.residue:
+            return str(labels[self.atoms[0]]).rsplit(" ", 1)[0]
         return " – ".join(str(labels[row]) for row in self.atoms)
+
+    def record(self) -> dict:
+        """What a session keeps of it."""
+        return {"atoms": list(self.atoms), "residue": self.residue}
 
 
 class Measurements(QObject):
@@ -56,12 +64,15 @@ class Measurements(QObject):
         super().__init__(parent)
         self.items: list[Measurement] = []
 
-    def add(self, atoms: tuple[int, ...] | list[int], n_atoms: int) -> Measurement:
-        """A new measurement of ``atoms`` (1 to 4 distinct rows below ``n_atoms``)."""
+    def add(self, atoms: tuple[int, ...] | list[int], n_atoms: int, residue: bool = False) -> Measurement:
+        """A new measurement of ``atoms`` (1 to 4 distinct rows below ``n_atoms``; with
+        ``residue``, one: a label of its residue)."""
         atoms = tuple(int(row) for row in atoms) if isinstance(atoms, (list, tuple)) else ()
         if len(atoms) not in KINDS or len(set(atoms)) != len(atoms) or not all(0 <= a < n_atoms for a in atoms):
             raise ValueError(f"a label or a measurement takes 1 to 4 different atoms; got {list(atoms)}")
-        measurement = Measurement(atoms)
+        if residue and len(atoms) != 1:
+            raise ValueError("a residue's label takes one atom, its Cα")
+        measurement = Measurement(atoms, bool(residue))
         self.items.append(measurement)
         self.changed.emit()
         return measurement

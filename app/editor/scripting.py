@@ -16,7 +16,7 @@ import numpy as np
 
 from app.editor.features.export import export_view
 from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
-from core.protein.lookup import find_atom
+from core.protein.lookup import find_atom, find_residues
 
 if TYPE_CHECKING:
     from app.editor.document import Document
@@ -117,12 +117,21 @@ class EditorAPI:
         return [document.row_label(int(row)) for row in self._editor.navigation.go_to(residues)]
 
     def measure(self, *atoms: int | str) -> float | None:
-        """Label one atom, or measure the distance of two, the angle of three or the dihedral of
-        four, as View ▸ Label Atom and the Measure tools do: atoms as coordinate rows or as
-        people name them (``'A:48 NZ'``, ``'/A:48@NZ'``, ``'A/48/NZ'``; in the edited chain
-        where none is named). Returns the value (Å or degrees; None for a label)."""
+        """Label one atom (or, named without an atom, ``'A:48'``, its residue), or measure the
+        distance of two, the angle of three or the dihedral of four, as View ▸ Label and the
+        Measure tools do: atoms as coordinate rows or as people name them (``'A:48 NZ'``,
+        ``'/A:48@NZ'``, ``'A/48/NZ'``; in the edited chain where none is named). Returns the
+        value (Å or degrees; None for a label)."""
         document = self._document
         chain = document.structure.segments[document.segment].chain if document.editable else None
+        if len(atoms) == 1 and isinstance(atoms[0], str) and document.editable:
+            try:
+                rows = find_residues(document.structure, atoms[0], chain)
+            except ValueError:
+                rows = []
+            if len(rows) == 1:  # a residue: its label
+                document.measurements.add([int(document.ca_rows[rows[0]])], len(document.model.coords), True)
+                return None
         rows = [int(atom) if isinstance(atom, (int, np.integer)) else find_atom(document.structure, atom, chain)
                 for atom in atoms]
         return document.measurements.add(rows, len(document.model.coords)).value(document.model.coords)

@@ -1,7 +1,7 @@
-"""Labels and measurements picked with the mouse: *View ▸ Label Atom*, *Measure Distance*,
+"""Labels and measurements picked with the mouse: *View ▸ Label*, *Measure Distance*,
 *Measure Angle* or *Measure Dihedral* makes the next clicks in the view pick atoms (a residue
-clicked where no atom is drawn gives its Cα) until there are enough; Esc or the same entry
-again stops. They are listed in the *Measurements* dock and drawn in the view
+clicked where no atom is drawn gives its Cα, and a label of the residue) until there are
+enough; Esc or the same entry again stops. They are listed in the *Measurements* dock and drawn in the view
 (:mod:`app.editor.scene.layers.measurements`)."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from app.editor.features.menus import Menus
 from app.editor.interaction.identify import Hit
 from app.editor.measurements import KINDS
 
-TOOLS = {1: ("&Label Atom", "Ctrl+Shift+L"), 2: ("Measure &Distance", "Ctrl+Shift+D"),
+TOOLS = {1: ("&Label", "Ctrl+Shift+L"), 2: ("Measure &Distance", "Ctrl+Shift+D"),
          3: ("Measure &Angle", "Ctrl+Shift+A"), 4: ("Measure Di&hedral", "Ctrl+Shift+H")}
 """Each tool's entry and shortcut, by the atoms it picks."""
 
@@ -55,8 +55,9 @@ class Measuring:
             row = hit.index if hit.kind == "atom" else int(self.document.ca_rows[hit.row])
             if row not in self.picked:
                 self.picked.append(row)
-            if len(self.picked) == self.wanted:
-                self.document.measurements.add(self.picked, len(self.document.model.coords))
+            if len(self.picked) == self.wanted:  # a label of a residue clicked where no atom is drawn
+                self.document.measurements.add(self.picked, len(self.document.model.coords),
+                                               residue=self.wanted == 1 and hit.kind == "residue")
                 self.picked = []
         self._say()
         return True

@@ -148,7 +148,7 @@ class Sessions:
         camera = [list(map(float, vector)) for vector in self.plotter.camera_position]
         return session.View(sorted(layer.name for layer in self.scene.layers), self.scene.colouring.value,
                             self.scene.fat_helices, camera, compared, self.scene.helix_cylinders,
-                            [list(m.atoms) for m in self.document.measurements.items],
+                            [m.record() for m in self.document.measurements.items],
                             None if self.scene.slab is None else list(self.scene.slab))
 
     def _apply_view(self, view: session.View) -> None:
@@ -161,10 +161,10 @@ class Sessions:
         self.clipping.set(None if view.slab is None else (view.slab[0], view.slab[1]))
         measurements = self.document.measurements
         measurements.replace([])
-        for atoms in view.measurements:
+        for kept in view.measurements:
             try:
-                measurements.add(atoms, len(self.document.model.coords))
-            except (TypeError, ValueError) as error:  # a session written by hand, or damaged
+                measurements.add(kept.get("atoms"), len(self.document.model.coords), bool(kept.get("residue")))
+            except (AttributeError, TypeError, ValueError) as error:  # a session written by hand, or damaged
                 self.window.statusBar().showMessage(f"a measurement of the session left out: {error}", 15000)
         for item in view.compared:
             try:

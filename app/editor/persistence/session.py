@@ -44,8 +44,8 @@ class View:
     camera: list[list[float]]
     compared: list[ComparedFile]
     helix_cylinders: bool = False
-    measurements: list[list[int]] = field(default_factory=list)
-    """The atoms (coordinate rows) of each label and measurement."""
+    measurements: list[dict] = field(default_factory=list)
+    """Each label and measurement: its atoms (coordinate rows) and whether it labels a residue."""
     slab: list[float] | None = None
     """The clipping slab (Å in front of and behind the centre), or None."""
 

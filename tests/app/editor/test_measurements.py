@@ -84,16 +84,17 @@ def test_labels_angles_and_dihedrals_from_rw_are_gemmis_and_come_back_with_the_s
     window = open_window("4HHB.pdb.gz")
     rw, document = window.rw, window.document
     assert rw.measure("B:48 CA") is None  # a label
+    assert rw.measure("C:LYS40") is None  # a residue's label
     angle = rw.measure("A:45 N", "A:45 CA", "A:45 C")
     phi = rw.measure("/A:44@C", "A/45/N", "chain A and resi 45 and name CA", "A:HIS45 C")
     coords = document.model.coords
-    rows = [atoms for atoms in (m.atoms for m in document.measurements.items)]
-    p = [_position(coords, row) for row in rows[2]]
-    assert angle == pytest.approx(np.degrees(gemmi.calculate_angle(*[_position(coords, r) for r in rows[1]])))
+    rows = [m.atoms for m in document.measurements.items]
+    p = [_position(coords, row) for row in rows[3]]
+    assert angle == pytest.approx(np.degrees(gemmi.calculate_angle(*[_position(coords, r) for r in rows[2]])))
     assert phi == pytest.approx(np.degrees(gemmi.calculate_dihedral(*p)))
-    assert rw.measurements == ["B:LEU48 CA", f"A:HIS45 N – A:HIS45 CA – A:HIS45 C: {angle:.1f}°",
+    assert rw.measurements == ["B:LEU48 CA", "C:LYS40", f"A:HIS45 N – A:HIS45 CA – A:HIS45 C: {angle:.1f}°",
                                f"A:PRO44 C – A:HIS45 N – A:HIS45 CA – A:HIS45 C: {phi:.1f}°"]
-    assert "B:LEU48 CA" in _texts(window)
+    assert {"B:LEU48 CA", "C:LYS40"} <= set(_texts(window))
     with pytest.raises(ValueError, match="no atom XX in A:HIS45"):
         rw.measure("A:45 XX", "A:45 CA")
     with pytest.raises(ValueError, match="1 to 4 different atoms"):
@@ -101,8 +102,19 @@ def test_labels_angles_and_dihedrals_from_rw_are_gemmis_and_come_back_with_the_s
     saved = window.sessions.write_session(tmp_path / "measured")
     window.measurements_panel.table.selectRow(0)
     window.measurements_panel.delete.click()
-    assert len(rw.measurements) == 2
+    assert len(rw.measurements) == 3
     assert window.sessions.open_session(saved)
-    assert rw.measurements[0] == "B:LEU48 CA" and len(rw.measurements) == 3
+    assert rw.measurements[:2] == ["B:LEU48 CA", "C:LYS40"] and len(rw.measurements) == 4
     rw.open(Path(__file__).resolve().parents[2] / "data" / "1UBQ.pdb.gz")  # another structure: none
     assert rw.measurements == [] and window.measurements_panel.table.rowCount() == 0
+
+
+def test_a_residue_clicked_with_the_label_tool_is_labelled(open_window: Opener) -> None:
+    window = open_window("1UBQ.pdb.gz")  # the cartoon only: a click names a residue
+    document = window.document
+    window.display_panel.layer_boxes[Layer.CONTROL_POINTS].setChecked(False)
+    window.measuring.tools.actions()[0].trigger()  # View ▸ Label
+    assert window.statusBar().currentMessage() == "Label: click an atom (Esc stops)"
+    _click(window, document.model.coords[document.ca_rows[47]])
+    assert window.rw.measurements == ["A:LYS48"] and _texts(window) == ["A:LYS48"]
+    assert window.measuring.wanted == 1  # still labelling
