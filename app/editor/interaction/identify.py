@@ -79,7 +79,8 @@ def describe(document: Document, hit: Hit) -> str:
     if hit.row < 0:  # a ligand, an ion or a nucleotide
         table = structure.atoms
         k = hit.index
-        return f"{table.chain[k]}:{table.resname[k]}{table.resseq[k]} {table.name[k]} ({table.element[k]})"
+        drawn = " · nucleic acid: drawn, not edited (no curve)" if table.category[k] == "nucleic" else ""
+        return f"{table.chain[k]}:{table.resname[k]}{table.resseq[k]} {table.name[k]} ({table.element[k]}){drawn}"
     segment = structure.segments[document.segment_of(hit.row)]
     name = document.row_label(hit.row) + (f" {structure.atoms.name[hit.index]}" if hit.kind == "atom" else "")
     return f"{name} · {SS_NAMES[segment.ss[hit.row - int(segment.residue_index[0])]]}"

@@ -6,6 +6,7 @@ from collections.abc import Callable
 import numpy as np
 
 from app.editor.docks.sequence import STRAND_GAP, _light
+from app.editor.interaction.identify import Hit, describe
 from app.editor.main_window import MainWindow
 from app.editor.scene import nucleic
 from app.editor.scene.layers.base import Layer
@@ -63,3 +64,11 @@ def test_the_sequence_bar_shows_the_strands_letters_on_their_bases_colours(open_
     colour = image.pixelColor(cell.left() + 2, cell.top() + 2)
     assert (colour.red(), colour.green(), colour.blue()) == _light(nucleic.BASE_COLOURS["C"])
     assert strip.sizeHint().width() >= (2 * (12 + STRAND_GAP)) * strip.cell
+
+
+def test_hovering_a_nucleotide_says_it_is_not_edited(open_window: Opener) -> None:
+    window = open_window("1LCD.cif.gz")
+    atoms = window.document.structure.atoms
+    row = int(np.flatnonzero((atoms.category == "nucleic") & (atoms.name == "P"))[0])
+    text = describe(window.document, Hit("atom", atoms.coords[row], -1, row))
+    assert text.endswith("P (P) · nucleic acid: drawn, not edited (no curve)")
