@@ -19,9 +19,12 @@ from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
 from core.protein.lookup import find_atom, find_residues
 
 if TYPE_CHECKING:
+    from app.editor.docks.panels import DisplayPanel
     from app.editor.document import Document
+    from app.editor.features.clipping import Clipping
     from app.editor.features.files import Files
     from app.editor.features.maps import MapsAndFits
+    from app.editor.features.models import Models
     from app.editor.features.navigation import Navigation
     from app.editor.features.sessions import Sessions
     from app.editor.map_correlation import LiveCorrelation
@@ -38,6 +41,9 @@ class Editor(Protocol):
     sessions: Sessions
     navigation: Navigation
     maps_and_fits: MapsAndFits
+    display_panel: DisplayPanel
+    clipping: Clipping
+    models: Models
 
     def quit_unattended(self, discard: bool = False) -> None:
         """Close without asking; unsaved edits stay in the journal unless ``discard``."""
@@ -144,6 +150,40 @@ class EditorAPI:
         return [m.names(document.structure) + ("" if m.kind == "label" else
                                                 f": {m.text(document.structure, document.model.coords)}")
                 for m in document.measurements.items]
+
+    def show(self, *layers: str, on: bool = True) -> None:
+        """Show (or with ``on=False`` hide) layers as the *Display* dock's boxes do, named as
+        ``--hide`` names them: ``'cartoon'``, ``'tube'``, ``'nucleic-acids'``, ``'other-models'``, ..."""
+        boxes = self._editor.display_panel.layer_boxes
+        for name in layers:
+            layer = next((layer for layer in boxes if layer.name.lower().replace("_", "-") == name), None)
+            if layer is None:
+                known = ", ".join(layer.name.lower().replace("_", "-") for layer in boxes)
+                raise ValueError(f"no layer {name!r}; layers: {known}")
+            boxes[layer].setChecked(on)
+
+    @property
+    def cylinders(self) -> bool:
+        """Whether the cartoon's helices are cylinders (the *Display* dock's box); settable."""
+        return self._editor.display_panel.cylinders.isChecked()
+
+    @cylinders.setter
+    def cylinders(self, on: bool) -> None:
+        self._editor.display_panel.cylinders.setChecked(bool(on))
+
+    @property
+    def slab(self) -> tuple[float, float] | None:
+        """The clipping slab, Å in front of and behind the centre of the view, or None (View ▸
+        Clip Slab); settable."""
+        return self._editor.clipping.scene.slab
+
+    @slab.setter
+    def slab(self, slab: tuple[float, float] | None) -> None:
+        self._editor.clipping.set(None if slab is None else (float(slab[0]), float(slab[1])))
+
+    def play_models(self, on: bool = True) -> None:
+        """Start (or stop) showing the models of an ensemble in turn, as View ▸ Play Models does."""
+        self._editor.models.play(on)
 
     def history(self) -> tuple[list[str], int]:
         """The names of the undo steps and the current position (steps done)."""

@@ -12,6 +12,7 @@ from pytestqt.qtbot import QtBot
 
 from app.editor.features.clipping import DEFAULT, PIXELS_PER_ANGSTROM
 from app.editor.main_window import MainWindow
+from app.editor.scene.layers.base import Layer
 
 Opener = Callable[[str], MainWindow]
 BACKGROUND = 40
@@ -58,3 +59,20 @@ def test_the_slab_clips_the_view_and_moves_as_in_pymol(open_window: Opener, qtbo
     assert _drawn(window) == pytest.approx(full, rel=0.02)
     assert window.sessions.open_session(saved)
     assert window.scene.slab == pytest.approx((front - 1.0, back - 1.0)) and window.clipping.toggle_action.isChecked()
+
+
+def test_rw_shows_the_layers_and_sets_the_slab_and_the_cylinders(open_window: Opener) -> None:
+    window = open_window("1UBQ.pdb.gz")
+    rw = window.rw
+    rw.show("tube")
+    rw.show("cartoon", on=False)
+    assert window.display_panel.layer_boxes[Layer.TUBE].isChecked() and window.scene.actors["tube"].GetVisibility()
+    assert not window.scene.actors["cartoon"].GetVisibility()
+    with pytest.raises(ValueError, match="no layer 'ribbon'; layers: cartoon, tube"):
+        rw.show("ribbon")
+    rw.slab = (6, 8)
+    assert rw.slab == (6.0, 8.0) == window.scene.slab and window.clipping.toggle_action.isChecked()
+    rw.slab = None
+    assert window.scene.slab is None and not window.clipping.toggle_action.isChecked()
+    rw.cylinders = True
+    assert window.scene.helix_cylinders and rw.cylinders

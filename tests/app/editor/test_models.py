@@ -45,3 +45,11 @@ def test_the_other_models_are_drawn_behind_the_edited_one_and_play_in_the_same_v
 def test_a_single_model_has_nothing_to_play(open_window: Opener) -> None:
     window = open_window("1UBQ.pdb.gz")
     assert not window.models.play_action.isEnabled() and window.scene.meshes["other_models"].n_points == 0
+
+
+def test_rw_plays_the_models(open_window: Opener, qtbot: QtBot) -> None:
+    window = open_window("1L2Y.pdb.gz")
+    window.rw.play_models()
+    qtbot.waitUntil(lambda: window.rw.model >= 2, timeout=5000)
+    window.rw.play_models(False)
+    assert not window.models.timer.isActive()
