@@ -203,11 +203,12 @@ class EditorAPI:
         document.finish_drag(f"Move point {int(index)} at level {document.shown_level():.2f}")
 
     def tug(self, residue: int | str, delta: object) -> None:
-        """Tug the curve shown at ``residue`` (index in the segment, or a label such as
-        ``'A:LYS48'`` or ``'48'``) by ``delta`` (Å): one undo step, as *Tug the curve* does."""
+        """Tug the curve shown at ``residue`` (index in the segment, or a residue of it as Go to
+        Residue reads it: ``'A:LYS48'``, ``'A:31B'``, ``'48'``) by ``delta`` (Å): one undo step,
+        as *Tug the curve* does."""
         document = self._editable
         labels = document.labels()
-        index = _residue_index(labels, residue)
+        index = _residue_index(document, residue)
         document.preview_tug(float(document.paths[document.segment].residue_u[index]), _vector(delta))
         document.finish_drag(f"Tug curve at {labels[index]} at level {document.shown_level():.2f}")
 
@@ -307,15 +308,18 @@ def _vector(delta: object) -> np.ndarray:
     return vector
 
 
-def _residue_index(labels: tuple[str, ...], residue: int | str) -> int:
-    """Index of ``residue`` (an index, 'A:LYS48', or a number with insertion code '48A')."""
+def _residue_index(document: Document, residue: int | str) -> int:
+    """Index in the edited segment of ``residue``: an index, or a residue as Go to Residue
+    reads it (``'A:LYS48'``, ``'A:31B'``, ``'48A'``, ``'/A:48'``; in the edited chain where
+    none is named)."""
+    labels = document.labels()
     if isinstance(residue, (int, np.integer)):
         if not 0 <= residue < len(labels):
             raise IndexError(f"residue {residue} does not exist: the segment has {len(labels)}")
         return int(residue)
-    text = str(residue).strip()
-    for k, label in enumerate(labels):
-        number = label.split(":", 1)[1].lstrip("ABCDEFGHIJKLMNOPQRSTUVWXYZ")
-        if text in (label, number):
-            return k
-    raise ValueError(f"no residue {residue!r} in this segment ({labels[0]}–{labels[-1]})")
+    segment = document.structure.segments[document.segment]
+    rows = find_residues(document.structure, str(residue), segment.chain)
+    index = int(rows[0]) - int(segment.residue_index[0])
+    if len(rows) != 1 or not 0 <= index < len(segment):
+        raise ValueError(f"{str(residue).strip()!r} is not one residue of the edited segment ({labels[0]}–{labels[-1]})")
+    return index

@@ -52,6 +52,15 @@ def test_state_edits_and_history(qtbot: QtBot) -> None:
     assert rw.history()[1] == 1
     with pytest.raises(ValueError, match="no residue"):
         rw.tug("A:XYZ9999", [1, 0, 0])
+    number = labels[60].split(":")[1].lstrip("ABCDEFGHIJKLMNOPQRSTUVWXYZ")  # one residue syntax everywhere
+    for typed in (f"A:{number}", f"/A:{number}", f"A/{number}/", labels[40].split(":")[1][3:]):
+        rw.tug(typed, [0.5, 0.0, 0.0])
+    assert [name.split(" at level")[0] for name in rw.history()[0][1:5]] == [
+        f"Tug curve at {labels[k]}" for k in (60, 60, 60, 40)]
+    for _ in range(4):
+        rw.undo()
+    with pytest.raises(ValueError, match="is not one residue of the edited segment"):
+        rw.tug("A:40-45", [1, 0, 0])
     with pytest.raises(IndexError):
         rw.move(10_000, [1, 0, 0])
     with pytest.raises(ValueError, match="three finite numbers"):
