@@ -241,13 +241,15 @@ class Document(QObject):
             self._level_changed()
 
     def set_segment(self, segment: int) -> None:
-        """Choose the segment whose control points are shown and edited."""
+        """Choose the segment whose control points are shown and edited, at the same depth
+        below its top level as the one before (the same share of the detail left out)."""
         self._check_editable()
         if not 0 <= segment < len(self._model.ribbons):
             raise ValueError(f"segment must be in [0, {len(self._model.ribbons) - 1}]; got {segment}")
         if segment != self.segment:
+            below_top = self.max_level - self.shown_level()  # the detail left out, kept (not the level)
             self.segment = segment
-            self.level = min(self.level, self.max_level)
+            self.level = max(0.0, self.max_level - below_top)
             self._set_pick(None)
             self.segmentChanged.emit()
             self._level_changed()

@@ -114,10 +114,13 @@ def test_segments_of_a_multichain_entry(qapp: QApplication) -> None:
     document = Document()
     document.open(DATA / "4YVS.cif.gz")
     assert len(document.paths) == 20
-    document.set_level(7.5)
+    document.set_level(7.5)  # 0.32 below the top of segment 0 (226 residues)
     document.set_segment(2)  # chain B, residues 190-237: 48 residues
     assert document.max_level == pytest.approx(np.log2(48))
-    assert document.level == document.max_level
+    assert document.level == pytest.approx(np.log2(48) - (np.log2(226) - 7.5))  # the same share of the detail
+    document.set_level(2.0)  # a coarse level of the short chain: as far below the long one's top
+    document.set_segment(0)
+    assert document.level == pytest.approx(np.log2(226) - (np.log2(48) - 2.0))
     assert document.segment_label(2) == "B  THR190–GLN237 (48 residues)"
     with pytest.raises(ValueError, match="segment must be in"):
         document.set_segment(20)
