@@ -97,6 +97,7 @@ class MainWindow(QMainWindow):
 
         self.dimension_panel = RibbonDimensionPanel(self.document)
         self.dimension_panel.slider.valueChanged.connect(self.scene.moved)  # less detail while the level slides
+        self.dimension_panel.segment.activated.connect(lambda _: (self.scene.frame_segment(), self.plotter.render()))
         self.display_panel = DisplayPanel(self.scene)
         self.comparison = Comparison(self.document)  # after the scene: it redraws once the scene is rebuilt
         self.comparison_view = ComparisonView(self.comparison, self.plotter)

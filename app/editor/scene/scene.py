@@ -192,7 +192,9 @@ class Scene(QObject):
         renderer.camera.zoom(1.15)
 
     def frame_segment(self) -> None:
-        """Centre the view on the edited segment and fit it in, looking from where the camera is."""
+        """Centre the view on the edited segment and fit it in, looking from where the camera is
+        (when the segment is chosen in the *Ribbon dimension* dock; a click on another chain
+        leaves the camera where it is)."""
         structure = self.document.structure
         ca = self.document.model.coords[self.document.ca_rows[structure.segments[self.document.segment].residue_index]]
         low, high = ca.min(axis=0) - 2.0, ca.max(axis=0) + 2.0
@@ -295,8 +297,7 @@ class Scene(QObject):
             layer.segment_changed()
         if self.others is not Others.SHOWN:
             self._draw_others()
-        self.frame_segment()
-        self._on_level()
+        self._on_level()  # (the camera stays: it moves only when asked, see frame_segment)
 
     def _on_pick(self) -> None:
         for layer in self._drawn:

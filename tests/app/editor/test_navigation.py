@@ -161,7 +161,8 @@ def test_double_click_centres_on_what_is_under_the_pointer(window: MainWindow, q
 
 
 def test_a_click_on_another_chain_edits_that_chain(open_window: Opener, qtbot: QtBot) -> None:
-    """4HHB: a click (no motion) on chain B's tube makes it the edited segment and frames it."""
+    """4HHB: a click (no motion) on chain B's ribbon makes it the edited segment; the camera
+    stays where it is (it moves only when asked: choosing the segment in the dock frames it)."""
     window = open_window("4HHB.pdb.gz")
     document = window.document
     window.scene.set_layer(Layer.CONTROL_POINTS, False)
@@ -169,17 +170,23 @@ def test_a_click_on_another_chain_edits_that_chain(open_window: Opener, qtbot: Q
     rows = document.structure.segments[segment_b].residue_index
     row = _front_residue(window, rows)
     at = _widget_point(window, _ca(window, row))
+    before = window.plotter.camera_position
     qtbot.mousePress(window.plotter, Qt.MouseButton.LeftButton, pos=at)
     qtbot.mouseRelease(window.plotter, Qt.MouseButton.LeftButton, pos=at)
     assert document.segment == segment_b and list(document.selection) == [row]
-    ca = _ca(window, rows)
-    np.testing.assert_allclose(_focal(window), (ca.min(axis=0) + ca.max(axis=0)) / 2, atol=0.5)
+    assert window.plotter.camera_position == before
     assert document.undo_stack.count() == 0
     camera = window.plotter.camera_position
     qtbot.mousePress(window.plotter, Qt.MouseButton.LeftButton, pos=at)  # a real drag turns the camera only
     qtbot.mouseMove(window.plotter, at + QPoint(40, 10))
     qtbot.mouseRelease(window.plotter, Qt.MouseButton.LeftButton, pos=at + QPoint(40, 10))
     assert window.plotter.camera_position != camera and document.segment == segment_b
+    combo = window.dimension_panel.segment  # chosen in the dock: framed
+    combo.setFocus()
+    qtbot.keyClick(combo, Qt.Key.Key_Down)
+    assert document.segment == segment_b + 1
+    ca = _ca(window, document.structure.segments[segment_b + 1].residue_index)
+    np.testing.assert_allclose(_focal(window), (ca.min(axis=0) + ca.max(axis=0)) / 2, atol=0.5)
 
 
 # ------------------------------------------------------------------ the sequence bar

@@ -595,7 +595,11 @@ def test_choosing_another_chain_frames_it(qtbot: QtBot) -> None:
     """4HHB: the segment box moves the camera to the chosen chain and fits it in the view (#17)."""
     window = _window(qtbot, DATA / "4HHB.pdb.gz")
     document = window.document
-    window.dimension_panel.segment.setCurrentIndex(4)  # as a choice in the box does
+    combo = window.dimension_panel.segment
+    combo.setFocus()
+    for _ in range(4):  # a choice in the box, by the keyboard
+        qtbot.keyClick(combo, Qt.Key.Key_Down)
+    assert document.segment == 4
     segment = document.structure.segments[4]
     ca = document.model.coords[document.ca_rows[segment.residue_index]]
     camera = window.plotter.renderer.camera
