@@ -80,6 +80,19 @@ class SurfacePanel(QWidget):
         self.opacity.valueChanged.connect(lambda value: layer.set_opacity(value / 100))
         self.recompute.clicked.connect(layer.recompute)
         layer.updated.connect(self.refresh)
+        layer.document.loaded.connect(self._loaded)
+        self._loaded()
+
+    def _loaded(self) -> None:
+        """A new structure: the surface can be shown; the DNA cylinder is offered only where
+        there are nucleic acids (for a protein it fails: no axis to cast from)."""
+        document = self.layer.document
+        nucleic = document.model is not None and bool((document.structure.atoms.category == "nucleic").any())
+        item = self.kind.model().item(list(KIND_NAMES).index("dna"))
+        item.setEnabled(nucleic)
+        item.setToolTip("" if nucleic else "for DNA and RNA: this entry has none")
+        if not nucleic and self.layer.kind == "dna":
+            self.layer.set_kind("ses")
         self.refresh()
 
     def refresh(self) -> None:

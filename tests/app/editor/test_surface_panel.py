@@ -171,7 +171,11 @@ def test_edits_make_the_surface_stale_until_recomputed(qtbot: QtBot, ubiquitin: 
 def test_failures_are_reported_and_a_new_file_drops_the_cache(qtbot: QtBot, ubiquitin: Document) -> None:
     window = _window(qtbot, ubiquitin)
     panel = window.surface_panel
-    _show(qtbot, panel, "dna")  # ubiquitin has no double helix
+    dna = panel.kind.model().item(list(KIND_NAMES).index("dna"))
+    assert not dna.isEnabled() and "has none" in dna.toolTip()  # not offered: ubiquitin has no double helix
+    panel.layer.set_kind("dna")  # asked all the same (as a script may): the failure is reported
+    panel.show_box.setChecked(True)
+    qtbot.waitUntil(lambda: not panel.layer.busy, timeout=BUILD_TIMEOUT_MS)
     assert panel.layer.built is None and "DNA cylinder: 1UBQ" in panel.figures.text()
     assert "surface" not in window.plotter.actors
     panel.kind.setCurrentIndex(list(KIND_NAMES).index("map"))
@@ -249,3 +253,17 @@ def test_opening_another_file_drops_the_running_build(qtbot: QtBot, open_window:
     assert not new.is_alive() and panel.layer.built.surface.kind == "globe"
     ca = window.document.model.coords[window.document.ca_rows]
     assert np.linalg.norm(_actor_mesh(window).points.mean(axis=0) - ca.mean(axis=0)) < 5.0  # around the Trp-cage
+
+
+def test_show_surface_can_be_ticked_after_every_load_and_dna_is_offered_for_dna(qtbot: QtBot) -> None:
+    """#35: the box stayed greyed out after a load into an empty window until the kind changed."""
+    window = _window(qtbot, Document())
+    panel = window.surface_panel
+    assert not panel.show_box.isEnabled()
+    window.files.open_file(DATA / "1UBQ.pdb.gz")
+    assert panel.show_box.isEnabled()
+    dna = panel.kind.model().item(list(KIND_NAMES).index("dna"))
+    assert not dna.isEnabled()
+    window.document.undo_stack.setClean()
+    window.files.open_file(DATA / "1BNA.pdb.gz")
+    assert panel.show_box.isEnabled() and dna.isEnabled()
