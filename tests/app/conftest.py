@@ -25,10 +25,13 @@ class Questions:
 
     def __init__(self) -> None:
         self.asked: list[str] = []
+        self.defaults: list[object] = []
+        """The button each question offers as its default (None where it names none)."""
         self.answer = QMessageBox.StandardButton.Discard
 
     def __call__(self, parent: object, title: str, text: str, *args: object) -> QMessageBox.StandardButton:
         self.asked.append(text)
+        self.defaults.append(args[1] if len(args) > 1 else None)
         return self.answer
 
 

@@ -95,6 +95,8 @@ class RibbonDimensionPanel(QWidget):
         form.addRow("Shown", self.level_text)
         form.addRow("Curve segments", self.segments_text)
         form.addRow("Control points", self.points_text)
+        self.points_text.setToolTip("Control points whose basis functions reach a residue are shown; the others "
+                                    "only shape the curve beyond the chain's ends")
         form.addRow("rms |Cα − C^r|", self.rms_text)
         form.setRowVisible(self.note, False)  # instead of the figures, for a structure that is only viewed
         form.setRowVisible(self.model_number, False)  # for a multi-model entry

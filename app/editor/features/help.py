@@ -27,6 +27,10 @@ MOUSE = (
     ("Click a residue", "select it; on another chain, edit that chain"),
     ("Double click", "centre the view on what is under the pointer"),
     ("Drag elsewhere", "turn the view; wheel: zoom"),
+    ("Middle-button drag (or Shift+drag elsewhere)", "pan the view"),
+    ("Right-button drag", "zoom"),
+    ("Shift+right-button drag", "move the clipping slab's near (up, down) and far (left, right) planes"),
+    ("View ▸ Label, Measure …, then click atoms", "label them, or measure distance, angle, dihedral"),
     ("Point at anything", "name it in a tooltip and the status bar"),
     ("Sequence bar: click, drag, Shift+click", "select residues and centre on them"),
 )

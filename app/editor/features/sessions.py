@@ -117,9 +117,9 @@ class Sessions:
             return
         buttons = QMessageBox.StandardButton
         answer = QMessageBox.question(
-            self.window, PROG, "ribbonwave did not close cleanly last time. Restore the unsaved edits "
-            f"({time_label(left[0])})? Discard deletes them; Ignore keeps them for later.",
-            buttons.Yes | buttons.Discard | buttons.Ignore)
+            self.window, PROG, f"ribbonwave did not close cleanly last time. Restore the unsaved edits of "
+            f"{journal_subject(left[0])} ({time_label(left[0])})? Discard deletes them; Ignore keeps them for later.",
+            buttons.Yes | buttons.Discard | buttons.Ignore, buttons.Yes)
         if answer == buttons.Yes:
             try:
                 self.restore_journal(left[0])
@@ -175,6 +175,15 @@ class Sessions:
             self.comparison.set_visible(len(self.comparison.items) - 1, item.visible)
         self.plotter.camera_position = [tuple(vector) for vector in view.camera]
         self.plotter.render()
+
+
+def journal_subject(path: Path) -> str:
+    """The name of the file whose edits the journal at ``path`` holds ('the edits' if unreadable)."""
+    try:
+        entries, _ = records.read(path)
+        return Path(entries[0].fields["path"]).name if entries and entries[0].kind == "header" else "a structure"
+    except (OSError, records.RecordError, KeyError, TypeError):
+        return "a structure"
 
 
 def time_label(path: Path) -> str:

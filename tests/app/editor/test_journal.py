@@ -156,7 +156,8 @@ def test_the_next_start_offers_to_restore(qtbot: QtBot, questions) -> None:
     window = _window(qtbot, DATA / "3PTB.pdb.gz")
     questions.answer = QMessageBox.StandardButton.Yes
     window.sessions.offer_recovery()
-    assert "did not close cleanly" in questions.asked[-1]
+    assert "did not close cleanly" in questions.asked[-1] and "unsaved edits of 1UBQ.pdb.gz (" in questions.asked[-1]
+    assert questions.defaults[-1] == QMessageBox.StandardButton.Yes  # Enter restores
     assert window.rw.history() == history and np.array_equal(window.document.model.coords, coords)
     assert window.document.modified and window.document.path.name == "1UBQ.pdb.gz"
     window.editing.redo_action.trigger()

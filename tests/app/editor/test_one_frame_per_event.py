@@ -145,6 +145,9 @@ def test_help_names_the_keys_bound_and_the_versions(qtbot: QtBot) -> None:
     assert reference.isVisible()
     assert "Go to Residue" in reference.text() and "Ctrl+L" in reference.text() and "Ctrl+Y" in reference.text()
     assert "Double click" in reference.text()
+    for gesture in ("Middle-button drag", "Right-button drag", "Shift+right-button drag", "Clip Slab", "Ctrl+K",
+                    "Measure Distance"):  # (#35: the pan and zoom drags were missing)
+        assert gesture in reference.text(), gesture
     reference.close()
     about = window.help.show_about()
     for part in (f"Qt {qVersion()}", f"VTK {vtk.vtkVersion.GetVTKVersion()}", f"gemmi {gemmi.__version__}"):
