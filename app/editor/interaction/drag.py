@@ -96,6 +96,8 @@ class _Grab:
     """Whether the pointer has gone CLICK_PIXELS from the press (a drag, not a click)."""
     shown: np.ndarray | None = None
     """The displacement previewed last (a release where the last move left the pointer shows nothing new)."""
+    along: str | None = None
+    """The axis Shift kept the motion to at the last event ('x', 'y', 'z'), or None."""
 
 
 class DragController:
@@ -121,9 +123,11 @@ class DragController:
         if grab is None:
             return False
         displacement = event.on_plane(grab.start, grab.normal) - grab.start
+        grab.along = None
         if event.shift:  # along the one allowed axis the pointer moves most along
             axis = grab.axes[np.argmax(np.abs(grab.axes @ displacement))]
             displacement = axis * float(axis @ displacement)
+            grab.along = "xyz"[int(np.argmax(np.abs(axis)))]
         grab.moved = grab.moved or float(np.linalg.norm(displacement)) >= CLICK_PIXELS * grab.pixel
         if grab.moved and not (grab.shown is not None and np.array_equal(displacement, grab.shown)):
             grab.shown = displacement
@@ -133,8 +137,9 @@ class DragController:
                 self.document.preview_tug(grab.u, displacement)
         if event.kind == "release":
             self._grab = None
-            if grab.moved:
-                self.document.finish_drag(f"{grab.label} at level {self.document.shown_level():.2f}")
+            if grab.moved:  # named with the axis Shift kept it to, as History shows it
+                along = f" along {grab.along}" if grab.along else ""
+                self.document.finish_drag(f"{grab.label}{along} at level {self.document.shown_level():.2f}")
         return True
 
     def cancel(self) -> None:

@@ -288,6 +288,8 @@ def test_handle_box_faces_move_in_their_plane_and_shift_keeps_one_axis(window: M
     window.plotter.render()
     moved = drag((80, 60), shift=True)
     assert np.count_nonzero(np.abs(moved) > 1e-6) == 1 and abs(moved[axis]) < 1e-6  # one axis of that plane
+    along = "xyz"[int(np.flatnonzero(np.abs(moved) > 1e-6)[0])]
+    assert document.undo_stack.text(0).endswith(f" along {along} at level {document.shown_level():.2f}")  # named
 
 
 def test_other_chains_dimmed_hidden_and_shown(open_window: Opener) -> None:
