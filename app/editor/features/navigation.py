@@ -20,6 +20,10 @@ if TYPE_CHECKING:
     from core.geometry.validation import Flag
 
 
+FLAG_MARGIN = 4.0
+"""Å around a flag's atoms kept in view when it is shown."""
+
+
 class Navigation:
     """Selecting residues of ``document`` and turning ``plotter``'s view, drawn by ``scene``, to them."""
 
@@ -62,8 +66,16 @@ class Navigation:
         self.plotter.render()
 
     def show_flag(self, flag: Flag) -> None:
-        """Centre the view on ``flag``'s marker and select its residues (see :meth:`select_and_centre`)."""
-        self.select_and_centre(np.array(flag.residues, dtype=np.int64), np.array(flag.position))
+        """Centre the view on ``flag``'s marker, select its residues (their atoms show: see
+        :mod:`app.editor.scene.layers.selection`) and zoom in until they fill about a third of
+        the view (never out)."""
+        residues = np.array(flag.residues, dtype=np.int64)
+        self.select_and_centre(residues, np.array(flag.position))
+        atoms = self.document.model.coords[np.isin(self.document.structure.atom_residue, residues)]
+        if len(atoms):
+            reach = float(np.linalg.norm(atoms - np.array(flag.position), axis=1).max()) + FLAG_MARGIN
+            self.scene.zoom_to(reach)
+            self.plotter.render()
 
     def go_to(self, text: str) -> np.ndarray:
         """Select and centre on the residues named by ``text`` (``A:45``, ``45`` in the edited

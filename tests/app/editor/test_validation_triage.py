@@ -139,9 +139,18 @@ def test_clicking_a_row_centres_the_view_on_the_problem(qtbot: QtBot) -> None:
     assert document.segment == 1  # the segment framed first, then centred on the flag
     np.testing.assert_allclose(camera.focal_point, flag.position, atol=1e-9)
     assert list(document.selection) == sorted(flag.residues)  # and its residues selected
+    atoms = np.isin(document.structure.atom_residue, flag.residues)  # their atoms shown (#35), zoomed in on
+    shown = window.scene.meshes["selection_atoms"]
+    np.testing.assert_allclose(shown.points, document.model.coords[atoms], atol=1e-4)
+    assert shown.n_lines > atoms.sum() / 2 and window.scene.actors["selection_atoms"].GetVisibility()  # bonds
+    reach = np.linalg.norm(document.model.coords[atoms] - flag.position, axis=1).max() + 4.0
+    assert camera.distance <= 3.0 * reach / np.tan(np.radians(camera.view_angle) / 2.0) + 1e-6
 
     def view() -> np.ndarray:
         return np.subtract(camera.position, camera.focal_point)
+
+    def unit(v: np.ndarray) -> np.ndarray:
+        return v / np.linalg.norm(v)
 
     same = next(k for k, f in enumerate(panel.listed) if k > 0 and _segment_of(window, f) == {1})
     other = next(k for k, f in enumerate(panel.listed) if not f.residues)  # a clash inside a haem
@@ -150,7 +159,8 @@ def test_clicking_a_row_centres_the_view_on_the_problem(qtbot: QtBot) -> None:
         _click_row(qtbot, window, row)
         assert document.segment == 1
         np.testing.assert_allclose(camera.focal_point, panel.listed[row].position, atol=1e-9)
-        np.testing.assert_allclose(view(), before, atol=1e-9)  # same direction and distance
+        np.testing.assert_allclose(unit(view()), unit(before), atol=1e-9)  # same direction,
+        assert np.linalg.norm(view()) <= np.linalg.norm(before) + 1e-9  # never further away
 
     focal = camera.focal_point
     _click_row(qtbot, window, panel.offenders.topLevelItemCount() - 1)  # "… and N more"

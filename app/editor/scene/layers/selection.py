@@ -1,5 +1,7 @@
-"""The selected residues: translucent balls around their Cα (``selection``), one small mesh made
-again when the selection changes and moved in place when an edit moves them."""
+"""The selected residues: translucent balls around their Cα (``selection``) and their atoms as
+bond sticks coloured by element (``selection_atoms``: what a validation flag involves shows
+without the whole Atoms layer), made again when the selection changes and moved in place when
+an edit moves them."""
 
 from __future__ import annotations
 
@@ -7,8 +9,9 @@ import numpy as np
 import pyvista as pv
 
 from app.editor.document import Change
+from app.editor.scene import molecule
 from app.editor.scene.layers.base import SHINY, SceneLayer
-from app.editor.scene.layers.meshes import glyphs, move_glyphs
+from app.editor.scene.layers.meshes import bond_lines, glyphs, move_glyphs
 
 SELECTION_COLOUR = (240, 40, 220)
 SELECTION_RADIUS = 1.4
@@ -16,17 +19,22 @@ SELECTION_RADIUS = 1.4
 
 
 class SelectionLayer(SceneLayer):
-    """Balls around the Cα of the selected residues (always shown)."""
+    """Balls around the Cα of the selected residues and their atoms (always shown)."""
 
-    names = ("selection",)
+    names = ("selection", "selection_atoms")
+    lines_as_tubes = ("selection_atoms",)
 
     def build(self) -> None:
         self.meshes["selection"] = pv.PolyData()
+        self.meshes["selection_atoms"] = pv.PolyData()
+        self._atoms = np.empty(0, dtype=np.int64)
         self.selection_changed()
 
     def update(self, change: Change) -> None:
         if len(self.document.selection):
             move_glyphs(self.meshes["selection"], slice(None), self._centres())
+        if self.meshes["selection_atoms"].n_points and np.isin(change.rows, self._atoms).any():
+            self.write("selection_atoms", slice(None), self.document.model.coords[self._atoms])
 
     def selection_changed(self) -> None:
         rows = self.document.selection
@@ -34,6 +42,15 @@ class SelectionLayer(SceneLayer):
         self.meshes["selection"].shallow_copy(glyphs(self._centres(), SELECTION_RADIUS, colours))
         if "selection" not in self.actors and len(rows):
             self.add("selection", scalars="colours", rgb=True, opacity=0.45, **SHINY)
+        structure, coords = self.document.structure, self.document.model.coords
+        self._atoms = np.flatnonzero(np.isin(structure.atom_residue, rows)) if len(rows) else np.empty(0, np.int64)
+        table = structure.atoms
+        bonds = np.searchsorted(self._atoms, molecule.bonds(coords, table.element, table.altloc, self._atoms))
+        atoms = (bond_lines(coords[self._atoms], bonds, molecule.element_colours(table.element[self._atoms]))
+                 if len(bonds) else pv.PolyData())
+        self.meshes["selection_atoms"].shallow_copy(atoms)
+        if "selection_atoms" not in self.actors and len(bonds):
+            self.add("selection_atoms", scalars="colours", rgb=True, line_width=4.0, render_lines_as_tubes=True)
 
     def _centres(self) -> np.ndarray:
         """(k, 3) the Cα of the selected residues."""
