@@ -54,6 +54,17 @@ class Measurement:
         return {"atoms": list(self.atoms), "residue": self.residue}
 
 
+def checked(atoms: object, n_atoms: int, residue: bool = False) -> Measurement:
+    """The measurement of ``atoms``: 1 to 4 distinct rows below ``n_atoms`` (with ``residue``,
+    one: a label of its residue); ValueError or TypeError for anything else."""
+    atoms = tuple(int(row) for row in atoms) if isinstance(atoms, (list, tuple)) else ()
+    if len(atoms) not in KINDS or len(set(atoms)) != len(atoms) or not all(0 <= a < n_atoms for a in atoms):
+        raise ValueError(f"a label or a measurement takes 1 to 4 different atoms; got {list(atoms)}")
+    if residue and len(atoms) != 1:
+        raise ValueError("a residue's label takes one atom, its Cα")
+    return Measurement(atoms, bool(residue))
+
+
 class Measurements(QObject):
     """The labels and measurements of a document, in the order they were made."""
 
@@ -65,14 +76,8 @@ class Measurements(QObject):
         self.items: list[Measurement] = []
 
     def add(self, atoms: tuple[int, ...] | list[int], n_atoms: int, residue: bool = False) -> Measurement:
-        """A new measurement of ``atoms`` (1 to 4 distinct rows below ``n_atoms``; with
-        ``residue``, one: a label of its residue)."""
-        atoms = tuple(int(row) for row in atoms) if isinstance(atoms, (list, tuple)) else ()
-        if len(atoms) not in KINDS or len(set(atoms)) != len(atoms) or not all(0 <= a < n_atoms for a in atoms):
-            raise ValueError(f"a label or a measurement takes 1 to 4 different atoms; got {list(atoms)}")
-        if residue and len(atoms) != 1:
-            raise ValueError("a residue's label takes one atom, its Cα")
-        measurement = Measurement(atoms, bool(residue))
+        """A new measurement of ``atoms`` (see :func:`checked`)."""
+        measurement = checked(atoms, n_atoms, residue)
         self.items.append(measurement)
         self.changed.emit()
         return measurement

@@ -16,6 +16,7 @@ from PySide6.QtGui import QKeySequence
 from PySide6.QtWidgets import QFileDialog, QMainWindow, QMessageBox
 
 from app import PROG
+from app.editor.measurements import checked
 from app.editor.persistence import journal, records, session
 from app.editor.persistence.recording import recording, replay
 from app.editor.scene.molecule import Colouring
@@ -159,13 +160,13 @@ class Sessions:
         panel.fat.setChecked(view.fat_helices)
         panel.cylinders.setChecked(view.helix_cylinders)
         self.clipping.set(None if view.slab is None else (view.slab[0], view.slab[1]))
-        measurements = self.document.measurements
-        measurements.replace([])
+        measured = []
         for kept in view.measurements:
             try:
-                measurements.add(kept.get("atoms"), len(self.document.model.coords), bool(kept.get("residue")))
+                measured.append(checked(kept.get("atoms"), len(self.document.model.coords), bool(kept.get("residue"))))
             except (AttributeError, TypeError, ValueError) as error:  # a session written by hand, or damaged
                 self.window.statusBar().showMessage(f"a measurement of the session left out: {error}", 15000)
+        self.document.measurements.replace(measured)  # drawn and listed once
         for item in view.compared:
             try:
                 self.comparison.add(item.path, item.chain, item.source)

@@ -25,6 +25,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
+from app.editor.scene.curves import eased
 from app.editor.scene.tube import cross
 
 
@@ -59,9 +60,7 @@ def sections(ss: np.ndarray, rings_per_residue: int, cylinders: bool = False) ->
     owner = np.minimum(np.arange(n * k + 1) // k, n - 1)
     kinds = {"E": STRAND} if cylinders else _KINDS
     by_residue = np.array([kinds.get(s, LOOP) for s in ss], dtype=float)
-    window = np.ones(k + 1) / (k + 1)
-    shapes = np.column_stack([np.convolve(np.pad(by_residue[owner, c], k // 2, mode="edge"), window, mode="valid")
-                              for c in range(3)])
+    shapes = eased(by_residue[owner], k)
     strand = np.asarray(ss) == "E"
     for last in np.flatnonzero(strand & ~np.append(strand[1:], False)):
         along = np.linspace(0.0, 1.0, k + 1)

@@ -50,6 +50,14 @@ class LevelCurve:
         return 2**self.level
 
 
+def eased(values: np.ndarray, rings_per_residue: int) -> np.ndarray:
+    """Per-ring ``values`` (n_rings, ...) averaged over a residue's rings around each: steps
+    from one residue to the next eased."""
+    window = np.ones(rings_per_residue + 1) / (rings_per_residue + 1)
+    padded = np.pad(values, [(rings_per_residue // 2,) * 2] + [(0, 0)] * (np.ndim(values) - 1), mode="edge")
+    return np.apply_along_axis(lambda column: np.convolve(column, window, mode="valid"), 0, padded)
+
+
 class SegmentPath:
     """Sampling parameters of one segment's ribbon: tube rings and level-curve samples.
 

@@ -6,6 +6,7 @@ No curve of the editor is defined on them: they are drawn, not edited."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.interpolate import make_interp_spline
@@ -55,8 +56,10 @@ class Nucleotides:
         return len(self.backbone)
 
 
+@lru_cache(maxsize=4)
 def nucleotides(atoms: AtomTable) -> Nucleotides:
-    """The nucleotides among ``atoms`` (category ``nucleic``) that have a phosphorus or a C4'."""
+    """The nucleotides among ``atoms`` (category ``nucleic``) that have a phosphorus or a C4'
+    (cached: the view and the sequence bar draw the same, and atom tables do not change)."""
     rows = np.flatnonzero(atoms.category == "nucleic")
     groups = np.split(rows, np.flatnonzero(np.diff(atoms.residue[rows])) + 1) if len(rows) else []
     backbone, outline, counts, glycosidic, colours, chain = [], [], [], [], [], []

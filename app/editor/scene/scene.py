@@ -130,14 +130,15 @@ class Scene(QObject):
     def set_fat_helices(self, on: bool) -> None:
         """Tube radius by secondary structure (sheet > helix > other) or uniform."""
         self.fat_helices = on
-        if self.document.editable:
-            for layer in self._drawn:
-                layer.reshape()
-            self.plotter.render()
+        self._reshape()
 
     def set_helix_cylinders(self, on: bool) -> None:
         """Helices of the cartoon as cylinders along their axes (Carson's Fig. 5), or spiral ribbons."""
         self.helix_cylinders = on
+        self._reshape()
+
+    def _reshape(self) -> None:
+        """The ribbons' sections follow the options (:meth:`SceneLayer.reshape`)."""
         if self.document.editable:
             for layer in self._drawn:
                 layer.reshape()

@@ -13,6 +13,7 @@ import itertools
 import numpy as np
 
 from app.editor.scene import tube
+from app.editor.scene.curves import eased
 from app.editor.scene.layers.base import Layer
 from app.editor.scene.layers.chains import Others
 from app.editor.scene.layers.meshes import Rows, shift
@@ -65,9 +66,3 @@ class TubeLayer(SweptLayer):
             by_residue = np.array([FAT_RADII[s] for s in segment.ss])[path.owner]
             radii.append(eased(by_residue, path.rings_per_residue))
         return np.concatenate(radii)
-
-
-def eased(values: np.ndarray, rings_per_residue: int) -> np.ndarray:
-    """Per-ring ``values`` averaged over a residue's rings around each: steps eased."""
-    window = np.ones(rings_per_residue + 1) / (rings_per_residue + 1)
-    return np.convolve(np.pad(values, rings_per_residue // 2, mode="edge"), window, mode="valid")
