@@ -50,7 +50,8 @@ def find_residues(structure: Structure, text: str, chain: str | None = None) -> 
         raise ValueError(f"cannot read {text.strip()!r} as residues: {HELP}")
     chains = [s.chain for s in structure.segments]
     if named.chain is not None and named.chain not in chains:
-        raise ValueError(f"no chain {named.chain} with a protein backbone (chains: {', '.join(dict.fromkeys(chains))})")
+        known = ", ".join(chain or "none (the file names no chain)" for chain in dict.fromkeys(chains))
+        raise ValueError(f"no chain {named.chain} with a protein backbone (chains: {known})")
     if named.first is None:  # a whole chain
         return np.concatenate([s.residue_index for s in structure.segments if s.chain == named.chain])
     wanted = named.chain if named.chain is not None else chain

@@ -93,3 +93,10 @@ def test_atoms_named_as_people_type_them(haemoglobin, text: str, chain: str | No
 def test_atoms_that_are_not_there_are_said_so(haemoglobin, text: str, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         find_atom(haemoglobin, text)
+
+
+def test_a_file_that_names_no_chain_says_so() -> None:
+    adk = read_structure(DATA / "1AKE_adk_closed.pdb.gz")  # chain column blank
+    with pytest.raises(ValueError, match=r"no chain A with a protein backbone \(chains: none \(the file names no"):
+        find_residues(adk, "chain A and resi 20-30")
+    assert len(find_residues(adk, "resi 20-30")) == 11
