@@ -30,6 +30,7 @@ from app.editor.commands import EditCommand
 from app.editor.measurements import Measurements
 from app.editor.scene.curves import LevelCurve, SegmentPath
 from core.geometry.regularize import FLANK, regularize_region, regularized
+from core.protein.assembly import assembly_path, assembly_text
 from core.protein.model import Edit, EditableModel
 from core.protein.reading import read_bytes, read_structure
 from core.protein.ribbon import RibbonKind
@@ -204,6 +205,14 @@ class Document(QObject):
         self.source = data
         self.save_path = None
         self.fileChanged.emit()
+
+    def open_assembly(self, path: Path, number: int, kind: RibbonKind | str = RibbonKind.PEPTIDE,
+                      model: int = 1, data: bytes | None = None) -> None:
+        """Open biological assembly ``number`` (from 1) of model ``model`` of ``path`` (or of its
+        content ``data``), as the mmCIF file :func:`~core.protein.assembly.assembly_path` names
+        (written only when saved)."""
+        text = assembly_text(path, read_bytes(path) if data is None else data, number=number, model=model)
+        self.open(assembly_path(path, number), kind, data=text.encode())
 
     def set_kind(self, kind: RibbonKind | str) -> None:
         """Switch between the peptide-plane and the Cα ribbon; only without edits to undo."""
@@ -386,8 +395,8 @@ class Document(QObject):
             raise ValueError(self.read_only_reason)
 
     def _set_model(self, model: EditableModel, keep_view: bool = False) -> None:
-        """Make ``model`` the document, at the first segment and the default level (or, with
-        ``keep_view``, at the segment and level shown, where the new model has them)."""
+        """Make ``model`` the document, at its longest segment (the first of them) and the default
+        level (or, with ``keep_view``, at the segment and level shown, where the new model has them)."""
         segment, level = self.segment, self.level
         if self.model is None or model.structure is not self.model.structure:
             self.measurements.replace([])  # (their rows name other atoms)
@@ -395,7 +404,8 @@ class Document(QObject):
         self.model = model
         self.paths = [SegmentPath(ribbon) for ribbon in model.ribbons]
         self.ca_rows = ca_rows(model.structure)
-        self.segment = segment if keep_view and segment < len(model.ribbons) else 0
+        longest = int(np.argmax([len(s) for s in model.structure.segments])) if model.ribbons else 0
+        self.segment = segment if keep_view and segment < len(model.ribbons) else longest
         default = float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
         self.level = min(level, self.max_level) if keep_view else default
         self.pick = None

@@ -102,6 +102,13 @@ def open_arguments(parser: argparse.ArgumentParser) -> None:
         help="model of a multi-model entry (e.g. an NMR ensemble) to show and edit, counted from 1 (default 1)",
     )
     parser.add_argument(
+        "--assembly",
+        type=bounded(int, 1, MAX_MODEL),
+        metavar="N",
+        help="open biological assembly N of FILE (its REMARK 350 or _pdbx_struct_assembly records, counted "
+        "from 1), built from --model: e.g. a virus capsid from its asymmetric unit",
+    )
+    parser.add_argument(
         "--level",
         type=bounded(float, *LEVEL),
         metavar="L",
@@ -207,13 +214,18 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
         except (OSError, records.RecordError, StructureError) as error:
             raise InputError(f"{left[0]}: cannot restore ({error})") from error
     elif args.file.name.endswith(SESSION_SUFFIX):
+        if args.assembly is not None:
+            raise InputError("--assembly: a session opens as it was saved; give a structure file")
         try:
             window.sessions.open_session(args.file, raise_errors=True)
         except SessionError as error:
             raise InputError(str(error)) from error
     else:
         try:
-            window.document.open(args.file, args.ribbon, model=args.model)
+            if args.assembly is None:
+                window.document.open(args.file, args.ribbon, model=args.model)
+            else:
+                window.document.open_assembly(args.file, args.assembly, args.ribbon, model=args.model)
         except StructureError as error:
             raise InputError(str(error)) from error
         if args.file != DEFAULT_STRUCTURE:

@@ -109,15 +109,26 @@ def read_atoms(path: str | os.PathLike[str], model: int = 1) -> AtomTable:
     return _atom_table(st.name, atoms)
 
 
-def _read_model(path: Path, data: bytes, model: int) -> tuple[str, str, str, gemmi.Structure, ScannedModel]:
-    """Text, its encoding, format, parsed structure and scanned model ``model`` (from 1) of a
-    file with finite atoms."""
+def parse_model(path: str | os.PathLike[str], data: bytes, model: int = 1) -> gemmi.Structure:
+    """The file's content ``data`` parsed by gemmi, which has model ``model`` (from 1; else StructureError)."""
+    return _parsed(Path(path), data, model)[3]
+
+
+def _parsed(path: Path, data: bytes, model: int) -> tuple[str, str, str, gemmi.Structure]:
+    """Text, its encoding, format and parsed structure of a file that has model ``model`` (from 1)."""
     text, encoding = _text(path, data)
     fmt = "mmcif" if _looks_like_mmcif(text) else "pdb"
     st = _parse(text, fmt, path)
     if isinstance(model, bool) or not isinstance(model, (int, np.integer)) or not 1 <= model <= len(st):
         raise StructureError(f"{path}: no model {model!r}; the file has {len(st)} model(s), "
                              f"numbered 1 to {len(st)} in file order")
+    return text, encoding, fmt, st
+
+
+def _read_model(path: Path, data: bytes, model: int) -> tuple[str, str, str, gemmi.Structure, ScannedModel]:
+    """Text, its encoding, format, parsed structure and scanned model ``model`` (from 1) of a
+    file with finite atoms."""
+    text, encoding, fmt, st = _parsed(path, data, model)
     try:
         atoms = scan_model(st[int(model) - 1])
     except (TypeError, ValueError, RuntimeError) as exc:  # e.g. a residue gemmi left without a number

@@ -13,10 +13,12 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from PySide6.QtCore import Qt
 from PySide6.QtGui import QKeySequence
-from PySide6.QtWidgets import QFileDialog, QMainWindow, QMessageBox, QStyle
+from PySide6.QtWidgets import QApplication, QFileDialog, QInputDialog, QMainWindow, QMessageBox, QStyle
 
 from app import EXAMPLES_DIR, PROG
+from core.protein.assembly import assemblies
 from core.protein.structure import StructureError
 
 if TYPE_CHECKING:
@@ -53,6 +55,7 @@ class Files:
         self.save_as_action = menus.action("Save &As…", QKeySequence.StandardKey.SaveAs, self.save_as)
         self.quit_action = menus.action("&Quit", QKeySequence.StandardKey.Quit, window.close)
         menus.add("open", self.open_action)
+        self.assembly_action = menus.add_entry("open", "Open Biological &Assembly…", self.open_assembly_dialog)
         self.recent_menu = menus.add_menu("open", "Open &Recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
         menus.add("save", self.save_action, self.save_as_action)
@@ -74,6 +77,37 @@ class Files:
             QMessageBox.critical(self.window, PROG, str(error))
             return False
         self.add_recent(Path(path))
+        return True
+
+    def open_assembly_dialog(self) -> bool:
+        """Choose one of the biological assemblies of the structure's file and open it (after
+        asking about unsaved edits); a file without assembly records is answered so."""
+        document = self.document
+        if document.model is None or document.path is None:
+            return False
+        try:
+            choices = assemblies(document.path, document.source, model=document.model_number)
+        except StructureError as error:
+            QMessageBox.critical(self.window, PROG, str(error))
+            return False
+        if not choices:
+            QMessageBox.information(self.window, PROG, f"{document.path.name} has no biological assembly records "
+                                    "(REMARK 350 or _pdbx_struct_assembly).")
+            return False
+        items = [choice.describe() + (f" ({choice.details})" if choice.details else "") for choice in choices]
+        item, chosen = QInputDialog.getItem(self.window, "Open Biological Assembly",
+                                            f"Assemblies of {document.path.name}:", items, 0, False)
+        if not chosen or not self.maybe_save():
+            return False
+        path, source, model = document.path, document.source, document.model_number
+        QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)  # a capsid takes seconds
+        try:
+            document.open_assembly(path, items.index(item) + 1, document.kind, model=model, data=source)
+        except StructureError as error:
+            QMessageBox.critical(self.window, PROG, str(error))
+            return False
+        finally:
+            QApplication.restoreOverrideCursor()
         return True
 
     def open_with(self, suffix: str, open_: Callable[[Path], object]) -> None:

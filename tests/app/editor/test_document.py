@@ -110,10 +110,20 @@ def test_ribbon_kind_changes_only_without_edits(ubiquitin: Document) -> None:
     assert ubiquitin.kind == "peptide" and ubiquitin.undo_stack.count() == 0
 
 
+def test_a_file_opens_on_its_longest_segment(qapp: QApplication) -> None:
+    document = Document()
+    document.open(DATA / "1ACB.pdb.gz")  # chymotrypsin's 13-residue chain first, then 131, 97 and 63
+    assert document.segment == 1 and document.segment_label(1).endswith("(131 residues)")
+    assert document.level == round(np.log2(131) - 2)
+    document.open(DATA / "4YVS.cif.gz")  # 226, 176, 48, 231, ...: the first of the longest
+    assert document.segment == 3 and len(document.labels()) == 231
+
+
 def test_segments_of_a_multichain_entry(qapp: QApplication) -> None:
     document = Document()
     document.open(DATA / "4YVS.cif.gz")
     assert len(document.paths) == 20
+    document.set_segment(0)
     document.set_level(7.5)  # 0.32 below the top of segment 0 (226 residues)
     document.set_segment(2)  # chain B, residues 190-237: 48 residues
     assert document.max_level == pytest.approx(np.log2(48))

@@ -302,8 +302,8 @@ def test_other_chains_dimmed_hidden_and_shown(open_window: Opener) -> None:
     tube = window.scene.meshes["tube"]
     rings = window.scene.part(TubeLayer).ring_start
     chains = [s.chain for s in document.structure.segments]
-    k = next(k for k, chain in enumerate(chains) if chain != chains[0])
-    edited, other = (slice(rings[g] * TUBE_SIDES, rings[g + 1] * TUBE_SIDES) for g in (0, k))
+    k = next(k for k, chain in enumerate(chains) if chain != chains[document.segment])
+    edited, other = (slice(rings[g] * TUBE_SIDES, rings[g + 1] * TUBE_SIDES) for g in (document.segment, k))
     colours = np.array(tube.point_data["colours"])
     assert colours[other].min() > colours[edited].min() + 60  # faded toward white
     points = np.array(tube.points)
