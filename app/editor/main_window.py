@@ -15,8 +15,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QSettings, QSize, Qt
-from PySide6.QtGui import QCloseEvent, QDragEnterEvent, QDropEvent, QKeySequence
+from PySide6.QtCore import QSettings, QSize, Qt, QTimer
+from PySide6.QtGui import QCloseEvent, QDragEnterEvent, QDropEvent, QKeySequence, QShowEvent
 from PySide6.QtWidgets import QDockWidget, QMainWindow, QUndoView, QWidget
 
 from app import PROG
@@ -25,6 +25,7 @@ from app.editor.docks.comparison import ComparisonPanel
 from app.editor.docks.console import PythonConsole
 from app.editor.docks.layout import (
     add_dock,
+    fit_frame,
     fitted,
     restore_layout,
     save_layout,
@@ -55,10 +56,10 @@ from app.editor.interaction.gestures import Gestures
 from app.editor.live_validation import LiveValidation
 from app.editor.map_correlation import LiveCorrelation
 from app.editor.persistence import journal
+from app.editor.scene.layers.validation_markers import ValidationMarkers
 from app.editor.scene.map_mesh import MapMesh
 from app.editor.scene.overlay import Comparison, ComparisonView
 from app.editor.scene.scene import Scene
-from app.editor.scene.layers.validation_markers import ValidationMarkers
 from app.editor.scene.view import new_view
 from app.editor.scripting import EditorAPI
 from app.editor.status_bar import StatusBar
@@ -146,6 +147,12 @@ class MainWindow(QMainWindow):
         self.close()
 
     # ------------------------------------------------------------------ events
+
+    def showEvent(self, event: QShowEvent) -> None:  # noqa: N802 (Qt override)
+        """Once the window manager has framed the window: its frame fits the screen."""
+        super().showEvent(event)
+        if not event.spontaneous():
+            QTimer.singleShot(0, self, lambda: fit_frame(self))
 
     def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802 (Qt override)
         """Ask about unsaved edits; then release the VTK render window with the window."""

@@ -3,7 +3,7 @@ the screen) and the arrangement of its docks and tool bar."""
 
 from __future__ import annotations
 
-from PySide6.QtCore import QSettings, QSize, Qt
+from PySide6.QtCore import QMargins, QPoint, QRect, QSettings, QSize, Qt
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
@@ -14,6 +14,8 @@ from PySide6.QtWidgets import (
 )
 
 GEOMETRY_KEY = "windowGeometry"
+FRAME_ALLOWANCE = QMargins(0, 32, 0, 0)
+"""Room left for the window manager's title bar before the window is shown and its frame known."""
 LAYOUT_KEY = "windowLayout"
 
 
@@ -35,13 +37,33 @@ def scrolled(widget: QWidget) -> QScrollArea:
     return area
 
 
-def fitted(size: QSize) -> QSize:
-    """``size`` shrunk to the available area of the screen (a 1366 x 768 laptop shows it all)."""
+def fitted(size: QSize, frame: QMargins = FRAME_ALLOWANCE) -> QSize:
+    """``size`` shrunk so that the window, with ``frame`` around it (the window manager's title
+    bar and borders), fits the available area of the screen (a 1366 x 768 laptop shows it all,
+    status bar included)."""
     screen = QApplication.primaryScreen()
     if screen is None:
         return size
-    room = screen.availableGeometry()
+    room = screen.availableGeometry().marginsRemoved(frame)
     return QSize(min(size.width(), room.width()), min(size.height(), room.height()))
+
+
+def fit_frame(window: QMainWindow) -> None:
+    """Once ``window`` is shown and its frame known: shrink and move it so that the whole frame
+    lies in the screen's available area (a window manager may decorate it more than
+    :data:`FRAME_ALLOWANCE`)."""
+    outer, inner = window.frameGeometry(), window.geometry()
+    frame = QMargins(inner.left() - outer.left(), inner.top() - outer.top(),
+                     outer.right() - inner.right(), outer.bottom() - inner.bottom())
+    screen = QApplication.primaryScreen()
+    if screen is None or frame.isNull():  # no frame (or not known yet): the allowance stands
+        return
+    window.resize(fitted(window.size(), frame))
+    room, outer = screen.availableGeometry(), window.frameGeometry()
+    left = max(room.left(), min(outer.left(), room.right() - outer.width() + 1))
+    top = max(room.top(), min(outer.top(), room.bottom() - outer.height() + 1))
+    if (left, top) != (outer.left(), outer.top()):
+        window.setGeometry(QRect(QPoint(left + frame.left(), top + frame.top()), window.size()))
 
 
 def tidy_tab_bars(window: QMainWindow) -> None:

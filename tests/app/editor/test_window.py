@@ -15,6 +15,7 @@ from PySide6.QtWidgets import QApplication, QFileDialog
 from pytestqt.qtbot import QtBot
 
 from app import DEFAULT_STRUCTURE
+from app.editor.docks.layout import fit_frame
 from app.editor.docks.panels import STEPS_PER_LEVEL
 from app.editor.document import Document
 from app.editor.features.files import RECENT_KEY
@@ -621,15 +622,35 @@ def test_the_window_fits_a_small_screen_and_keeps_its_layout(qtbot: QtBot, monke
     monkeypatch.setattr(QApplication, "primaryScreen", staticmethod(lambda: Laptop()))
     window = MainWindow()
     qtbot.addWidget(window)
-    assert window.width() <= 1366 and window.height() <= 728
-    window.resize(1000, 700)
+    assert window.width() <= 1366 and window.height() <= 728 - 32  # room for a title bar
+    window.resize(1000, 650)
     window.console_dock.show()
     qtbot.wait(10)
-    size = window.size()  # (as near 1000 x 700 as the docks allow)
+    size = window.size()  # (as near 1000 x 650 as the docks allow)
     window.close()
     again = MainWindow()
     qtbot.addWidget(again)
     assert again.size() == size and again.console_dock.isVisibleTo(again)
+
+
+def test_the_window_frame_fits_the_screen(qtbot: QtBot, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A window manager's frame (a 40-pixel title bar here) is inside the available area: the
+    status bar of a 1366 x 768 screen is not pushed off its bottom (#35)."""
+    from PySide6.QtCore import QRect
+
+    class Laptop:
+        def availableGeometry(self) -> QRect:  # noqa: N802 (Qt's name)
+            return QRect(0, 0, 1366, 768)
+
+    monkeypatch.setattr(QApplication, "primaryScreen", staticmethod(lambda: Laptop()))
+    window = MainWindow()
+    qtbot.addWidget(window)
+    window.resize(1366, 768)
+    window.move(30, 20)
+    monkeypatch.setattr(window, "frameGeometry", lambda: window.geometry().adjusted(-4, -40, 4, 4))
+    fit_frame(window)
+    assert QRect(0, 0, 1366, 768).contains(window.frameGeometry())
+    assert window.height() == 768 - 44 and window.width() == 1366 - 8
 
 
 def test_vtk_one_letter_keys_leave_the_view_alone(qtbot: QtBot, view_kind: str, open_window) -> None:  # noqa: ANN001
