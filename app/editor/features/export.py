@@ -215,8 +215,10 @@ class ExportImageDialog(QDialog):
 
     @staticmethod
     def _side_box(value: int) -> QSpinBox:
+        """A box for a side that takes any size typed (Qt's would drop the digit that takes it
+        out of range: 20000 became 2000); :meth:`_check` says which it refuses."""
         box = QSpinBox()
-        box.setRange(*IMAGE_SIDE)
+        box.setRange(IMAGE_SIDE[0], 2**31 - 1)
         box.setSuffix(" px")
         box.setValue(value)
         return box

@@ -130,6 +130,14 @@ def test_the_dialog_writes_what_its_fields_say(window: MainWindow, qtbot: QtBot,
     dialog.width_box.setValue(16384)
     dialog.height_box.setValue(16384)
     assert not _save_button(dialog).isEnabled() and "at most 33.6 million" in dialog.problem.text()
+    dialog.width_box.selectAll()
+    qtbot.keyClicks(dialog.width_box, "20000")  # too wide: kept as typed and refused, not cut to 2000
+    assert dialog.width_box.value() == 20000 and not _save_button(dialog).isEnabled()
+    assert dialog.problem.isVisible() and "Width must be a whole number of pixels in [1, 16384]; got 20000" in \
+        dialog.problem.text()
+    qtbot.keyClick(dialog.width_box, Qt.Key.Key_Return)  # Return does not save what the dialog refuses
+    assert dialog.isVisible() and not list(tmp_path.iterdir())
+    dialog.width_box.setValue(16384)
     dialog.keep_aspect.setChecked(True)  # the ratio of the fields from now on
     dialog.width_box.selectAll()
     qtbot.keyClicks(dialog.width_box, "480")
