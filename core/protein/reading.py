@@ -33,6 +33,8 @@ from core.protein.structure import AtomTable, Structure, StructureError, frozen
 MAX_INPUT_MB = 4096
 """MiB a structure file may hold, decompressed (the largest PDB entries hold a few hundred)."""
 LIMIT_VARIABLE = "RIBBONWAVE_MAX_INPUT_MB"
+GUNZIP_CHUNK = 2**24
+"""Bytes decompressed at a time."""
 
 
 def read_structure(
@@ -208,13 +210,17 @@ def _text(path: Path, data: bytes) -> tuple[str, str]:
     encoding that gives back its bytes: UTF-8, else Latin-1 (every byte is a character)."""
     if data[:2] == b"\x1f\x8b":
         limit = input_limit()
+        chunks, size = [], 0
         try:
             with gzip.GzipFile(fileobj=io.BytesIO(data)) as stream:
-                data = stream.read(limit + 1)  # never more than the limit in memory
+                while chunk := stream.read(GUNZIP_CHUNK):  # (read(limit) would allocate the whole limit)
+                    size += len(chunk)
+                    if size > limit:  # never more than the limit in memory
+                        raise StructureError(f"{path}: decompresses to more than the input limit ({_limit_text()})")
+                    chunks.append(chunk)
         except (OSError, EOFError, zlib.error) as exc:
             raise StructureError(f"{path}: corrupt gzip file ({exc})") from None
-        if len(data) > limit:
-            raise StructureError(f"{path}: decompresses to more than the input limit ({_limit_text()})")
+        data = b"".join(chunks)
     if not data.strip():
         raise StructureError(f"{path}: empty file")
     try:

@@ -520,6 +520,18 @@ def test_a_gzip_bomb_stops_at_the_input_limit_within_bounded_memory(tmp_path: Pa
     assert "decompresses to more than the input limit (512 MiB; set $RIBBONWAVE_MAX_INPUT_MB" in result.stdout
 
 
+def test_a_gzipped_file_reads_in_the_memory_it_needs_not_the_limit() -> None:
+    """Under the default limit (4 GiB) a small gzipped entry reads within a 1.5 GiB address
+    space: the decompression never asks for a buffer as large as the limit."""
+    script = ("import resource; resource.setrlimit(resource.RLIMIT_AS, (3 * 2**29, 3 * 2**29)); "
+              "import sys; from core.protein.reading import read_structure\n"
+              "print(read_structure(sys.argv[1]).n_atoms)")
+    environment = {key: value for key, value in os.environ.items() if key != "RIBBONWAVE_MAX_INPUT_MB"}
+    result = subprocess.run([sys.executable, "-c", script, str(DATA / "1UBQ.pdb.gz")], capture_output=True, text=True,
+                            timeout=120, env=environment, check=False)
+    assert result.returncode == 0 and result.stdout.split() == ["660"], result.stderr[-2000:]
+
+
 def test_the_input_limit_can_be_raised_or_lowered(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("RIBBONWAVE_MAX_INPUT_MB", "0.01")  # 10 kB: 1UBQ is more
     with pytest.raises(StructureError, match="more than the input limit"):
