@@ -28,7 +28,7 @@ from PySide6.QtGui import QUndoStack
 
 from app.editor.commands import EditCommand
 from app.editor.measurements import Measurements
-from app.editor.scene.curves import LevelCurve, SegmentPath
+from app.editor.scene.curves import LevelCurve, SegmentPath, rings_per_residue
 from core.geometry.regularize import FLANK, regularize_region, regularized
 from core.protein.assembly import assembly_path, assembly_text
 from core.protein.model import Edit, EditableModel
@@ -402,7 +402,8 @@ class Document(QObject):
             self.measurements.replace([])  # (their rows name other atoms)
         self.undo_stack.clear()
         self.model = model
-        self.paths = [SegmentPath(ribbon) for ribbon in model.ribbons]
+        rings = rings_per_residue(sum(len(ribbon.residue_u) for ribbon in model.ribbons))
+        self.paths = [SegmentPath(ribbon, rings) for ribbon in model.ribbons]
         self.ca_rows = ca_rows(model.structure)
         longest = int(np.argmax([len(s) for s in model.structure.segments])) if model.ribbons else 0
         self.segment = segment if keep_view and segment < len(model.ribbons) else longest

@@ -22,6 +22,15 @@ from core.protein.ribbon import Ribbon
 
 RINGS_PER_RESIDUE = 6
 """Tube rings per residue (the thin level curve has half as many samples)."""
+LARGE_RESIDUES = 10_000
+"""Residues above which a structure (a capsid, an assembly) is swept with
+:data:`LARGE_RINGS_PER_RESIDUE` rings a residue: a third fewer vertices to hold and to draw."""
+LARGE_RINGS_PER_RESIDUE = 4
+
+
+def rings_per_residue(n_residues: int) -> int:
+    """Tube rings per residue for a structure of ``n_residues`` residues in all its segments."""
+    return RINGS_PER_RESIDUE if n_residues <= LARGE_RESIDUES else LARGE_RINGS_PER_RESIDUE
 
 
 @dataclass(frozen=True, eq=False)

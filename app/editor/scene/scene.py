@@ -94,6 +94,9 @@ class Scene(QObject):
         """The layers, in drawing order."""
         self._drawn: list[SceneLayer] = []
         """The layers built for the structure shown (those that need no backbone when it has none)."""
+        self._unbuilt: list[SceneLayer] = []
+        """The layers of the structure shown that stay unbuilt while they are hidden (a hidden
+        layer costs no memory until it is first shown: the tube and Cα spheres of a capsid)."""
         self._control_points = self.part(ControlPointsLayer)
         self._concealed = False
         self._still_timer = QTimer(self, singleShot=True, interval=STILL_AFTER_MS)
@@ -278,9 +281,8 @@ class Scene(QObject):
             self.chains = Chains(self.document.structure)
             if self.chains.count > DIM_ABOVE_CHAINS:
                 self.others = Others.DIMMED
-        self._drawn = [layer for layer in self.parts if editable or not layer.needs_backbone]
-        for layer in self._drawn:
-            layer.build()
+        self._drawn = []
+        self._unbuilt = [layer for layer in self.parts if editable or not layer.needs_backbone]
         self._show_layers()
         self._update_caption()
         if self.others is not Others.SHOWN:
@@ -348,6 +350,15 @@ class Scene(QObject):
             layer.conceal(chain)
 
     def _show_layers(self) -> None:
+        """Show the layers switched on (built first if they never were), hide the others."""
+        new = [layer for layer in self._unbuilt if layer.visible]
+        for layer in new:
+            self._unbuilt.remove(layer)
+            layer.build()
+            if self._concealed:
+                layer.conceal(self.edited_chain())
+        if new:
+            self._drawn = [layer for layer in self.parts if layer in self._drawn or layer in new]
         for layer in self._drawn:
             layer.show(layer.visible)
 

@@ -9,7 +9,7 @@ from pytestqt.qtbot import QtBot
 
 from app.editor.document import Document
 from app.editor.main_window import MainWindow
-from app.editor.scene import cartoon
+from app.editor.scene import cartoon, curves
 from app.editor.scene.layers.base import Layer
 from app.editor.scene.layers.cartoon import CartoonLayer
 from app.editor.scene.layers.swept import SIDES
@@ -42,19 +42,26 @@ def _centres(window: MainWindow, segment: int) -> tuple[np.ndarray, np.ndarray]:
 
 def test_the_cartoon_is_shown_and_the_tube_is_a_choice(qtbot: QtBot) -> None:
     window = _window(qtbot, "1UBQ.pdb.gz")
-    assert window.scene.actors["cartoon"].GetVisibility() and not window.scene.actors["tube"].GetVisibility()
+    assert window.scene.actors["cartoon"].GetVisibility()
+    assert "tube" not in window.scene.meshes  # hidden: not built (no memory) until first shown
     boxes = window.display_panel.layer_boxes
     boxes[Layer.TUBE].setChecked(True)
     boxes[Layer.CARTOON].setChecked(False)
     assert window.scene.actors["tube"].GetVisibility() and not window.scene.actors["cartoon"].GetVisibility()
 
 
-def test_the_ribbon_lies_in_the_peptide_planes_and_strands_end_in_arrows(qtbot: QtBot) -> None:
+@pytest.mark.parametrize("large", [False, True])
+def test_the_ribbon_lies_in_the_peptide_planes_and_strands_end_in_arrows(qtbot: QtBot, large: bool,
+                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
     """At full resolution each helix or strand residue's middle ring lies across along its
     carbonyl C→O (made perpendicular to the curve), a ribbon as wide as its kind; on a strand's
-    last residue the ribbon narrows from the arrow's base towards the C terminus."""
+    last residue the ribbon narrows from the arrow's base towards the C terminus. So too with
+    the fewer rings of a large structure (taken as one here)."""
+    if large:
+        monkeypatch.setattr(curves, "LARGE_RESIDUES", 50)
     window = _window(qtbot, "1UBQ.pdb.gz")
     document = window.document
+    assert document.paths[0].rings_per_residue == (curves.LARGE_RINGS_PER_RESIDUE if large else 6)
     document.set_level(document.max_level)
     segment = document.structure.segments[0]
     rings, (centres, tangents) = _rings(window, 0), _centres(window, 0)

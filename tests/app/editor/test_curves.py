@@ -5,7 +5,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.editor.scene.curves import RINGS_PER_RESIDUE, SegmentPath
+from app.editor.scene.curves import (
+    LARGE_RESIDUES,
+    LARGE_RINGS_PER_RESIDUE,
+    RINGS_PER_RESIDUE,
+    SegmentPath,
+    rings_per_residue,
+)
 from core.curves.splines import spline_space
 from core.protein.reading import read_structure
 from core.protein.ribbon import RibbonKind, segment_ribbon
@@ -19,15 +25,16 @@ def ubiquitin():
 
 
 @pytest.mark.parametrize("kind", list(RibbonKind))
-def test_rings_cover_each_residue_span(ubiquitin, kind: RibbonKind) -> None:
+@pytest.mark.parametrize("k", [RINGS_PER_RESIDUE, LARGE_RINGS_PER_RESIDUE])
+def test_rings_cover_each_residue_span(ubiquitin, kind: RibbonKind, k: int) -> None:
     ribbon = segment_ribbon(ubiquitin, kind)
-    path = SegmentPath(ribbon)
+    path = SegmentPath(ribbon, k)
     n = len(ubiquitin)
-    assert path.n_rings == n * RINGS_PER_RESIDUE + 1
-    centre_rings = np.arange(n) * RINGS_PER_RESIDUE + RINGS_PER_RESIDUE // 2
+    assert path.n_rings == n * k + 1
+    centre_rings = np.arange(n) * k + k // 2
     np.testing.assert_allclose(path.u[centre_rings], ribbon.residue_u, atol=1e-15)  # residue point mid-span
     assert np.array_equal(path.owner[centre_rings], np.arange(n))
-    assert np.array_equal(path.rings(np.array([3])), np.arange(3 * RINGS_PER_RESIDUE, 4 * RINGS_PER_RESIDUE + 1))
+    assert np.array_equal(path.rings(np.array([3])), np.arange(3 * k, 4 * k + 1))
     assert np.array_equal(path.rings(np.arange(n)), np.arange(path.n_rings))
 
 
@@ -72,3 +79,9 @@ def test_tangents_at_a_curve_end_over_doubled_control_points() -> None:
     np.testing.assert_allclose(np.linalg.norm(tangents, axis=1), 1.0, atol=1e-12)
     assert tangents[0] @ tangents[1] > 0.95 and tangents[2] @ tangents[3] > 0.95  # continuous into the ends
     assert tangents[0] @ (centres[1] - centres[0]) > 0 and tangents[3] @ (centres[3] - centres[2]) > 0
+
+
+def test_a_large_structure_is_swept_with_fewer_rings() -> None:
+    """A capsid's 11,040 residues (2BUK's assembly) take 4 rings a residue, ubiquitin's 76 take 6."""
+    assert rings_per_residue(76) == rings_per_residue(LARGE_RESIDUES) == RINGS_PER_RESIDUE == 6
+    assert rings_per_residue(LARGE_RESIDUES + 1) == rings_per_residue(11_040) == LARGE_RINGS_PER_RESIDUE == 4

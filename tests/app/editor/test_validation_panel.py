@@ -89,6 +89,7 @@ def test_a_drag_is_regularized_on_release_in_one_undo_step(window: MainWindow) -
     assert np.all(np.abs(_peptide_bonds(window) - 1.33) <= 0.05)
     assert not np.array_equal(document.model.coords, original)
     regularized = document.model.coords.copy()
+    window.display_panel.layer_boxes[Layer.ATOMS].setChecked(True)  # built as first shown: from the coordinates now
     np.testing.assert_allclose(window.scene.meshes["atoms"].points, regularized, atol=1e-4)  # the view shows it
     window.editing.undo_action.trigger()
     assert np.array_equal(document.model.coords, original)

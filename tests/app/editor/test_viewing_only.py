@@ -114,7 +114,7 @@ def test_dna_opens_in_the_window_for_viewing_and_surfaces(qtbot: QtBot, tmp_path
     # a session of it opens again for viewing; a protein makes everything editable again
     saved = window.sessions.write_session(tmp_path / "dna")
     assert window.files.open_file(DATA / "1UBQ.pdb.gz") and document.editable
-    assert panel.slider.isEnabled() and panel.note.isHidden() and "tube" in scene.meshes
+    assert panel.slider.isEnabled() and panel.note.isHidden() and "cartoon" in scene.meshes
     assert all(action.isEnabled() for action in window.editing.mode_actions.actions())
     assert all(window.display_panel.layer_boxes[layer].isEnabled() for layer in BACKBONE_LAYERS)
     assert window.sessions.open_session(saved) and not document.editable

@@ -110,7 +110,7 @@ def test_window_shows_the_structure(window: MainWindow) -> None:
     assert window.windowTitle() == "1UBQ.pdb.gz[*] — ribbonwave" and not window.isWindowModified()
     cartoon = window.scene.meshes["cartoon"]
     assert cartoon.n_points == (76 * 6 + 1) * TUBE_SIDES + 2 * (TUBE_SIDES + 1)
-    assert window.plotter.actors["cartoon"].GetVisibility() and not window.plotter.actors["tube"].GetVisibility()
+    assert window.plotter.actors["cartoon"].GetVisibility() and "tube" not in window.plotter.actors  # (until shown)
     colours = {tuple(c) for c in cartoon.point_data["colours"]}
     assert set(molecule.SS_COLOURS.values()) <= colours
     assert "ions" not in window.plotter.actors  # ubiquitin has none
@@ -209,6 +209,8 @@ def test_dragging_a_control_point_edits_the_structure(
 ) -> None:
     document = window.document
     document.set_regularization(on_release=False)  # Carson's plain edit (regularization: test_validation_panel)
+    for layer in (Layer.ATOMS, Layer.TUBE):
+        window.display_panel.layer_boxes[layer].setChecked(True)
     document.set_level(document.max_level if level == "max" else level)
     window.plotter.render()
     original = document.model.coords.copy()
@@ -656,7 +658,7 @@ def test_the_window_frame_fits_the_screen(qtbot: QtBot, monkeypatch: pytest.Monk
 def test_vtk_one_letter_keys_leave_the_view_alone(qtbot: QtBot, view_kind: str, open_window) -> None:  # noqa: ANN001
     """'e' and 'q' would close VTK's or pyvista's window, 'w' draw wireframes, '3' stereo."""
     window = open_window("1UBQ.pdb.gz")
-    view, tube = window.plotter, window.scene.actors["tube"]
+    view, tube = window.plotter, window.scene.actors["cartoon"]
     view.setFocus()
     for key in "wq3e":
         qtbot.keyClick(view, key)
