@@ -10,7 +10,9 @@ import argparse
 import os
 import signal
 import sys
+import time
 import traceback
+from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -161,8 +163,13 @@ def run_open(args: argparse.Namespace) -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     window = MainWindow()
     window.files.unattended = script is not None or bool(images)
+    staged = not window.files.unattended  # a person waits: the window at once, the structure once read and drawn
+    if staged:
+        window.show()
+        _draw_empty_view(window)
     try:
-        _load(window, args)
+        with window.files.opening(_opened_name(args)) if staged else nullcontext():
+            _load(window, args)
     except InputError:
         window.close()
         raise
@@ -249,6 +256,27 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
             raise InputError(f"--compare {spec}: {error}") from error
     if args.compare:
         window.comparison_panel.parentWidget().raise_()  # the dock listing them in front of its tab group
+
+
+def _draw_empty_view(window: MainWindow, seconds: float = 2.0) -> None:
+    """Let the shown window draw its 3D view (its background) before the structure is read,
+    rather than leave whatever the screen held there."""
+    from PySide6.QtCore import QEventLoop
+    from PySide6.QtWidgets import QApplication
+
+    deadline = time.monotonic() + seconds
+    window.plotter.render()
+    while window.plotter.frames == 0 and time.monotonic() < deadline:
+        QApplication.processEvents(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents, 10)
+
+
+def _opened_name(args: argparse.Namespace) -> Path:
+    """What the arguments open, as its name is shown while it is read."""
+    from core.protein.assembly import assembly_path
+
+    if args.recover:
+        return Path("the unsaved edits")
+    return args.file if args.assembly is None else assembly_path(args.file, args.assembly)
 
 
 def _check_display() -> None:

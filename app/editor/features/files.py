@@ -9,16 +9,26 @@ sessions; a kind of file another feature opens (sessions) registers its opener
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QEventLoop, Qt
 from PySide6.QtGui import QKeySequence
-from PySide6.QtWidgets import QApplication, QFileDialog, QInputDialog, QMainWindow, QMessageBox, QStyle
+from PySide6.QtWidgets import (
+    QApplication,
+    QFileDialog,
+    QInputDialog,
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QProgressBar,
+    QStyle,
+)
 
 from app import EXAMPLES_DIR, PROG
-from core.protein.assembly import assemblies
+from core.protein.assembly import assemblies, assembly_path
 from core.protein.structure import StructureError
 
 if TYPE_CHECKING:
@@ -64,13 +74,36 @@ class Files:
         document.fileChanged.connect(self._update_title)
         self._update_title()
 
+    @contextmanager
+    def opening(self, path: Path) -> Iterator[None]:
+        """While ``path`` is read and drawn: its name in the title, "Opening NAME…" and a busy bar
+        at the right of the status bar and the wait cursor, all painted before the work blocks
+        the event loop."""
+        bar = self.window.statusBar()
+        note, busy = QLabel(f"Opening {path.name}…"), QProgressBar(maximumWidth=120, textVisible=False)
+        busy.setRange(0, 0)  # (no end known: the bar says only that work goes on)
+        for widget in (note, busy):
+            bar.addPermanentWidget(widget)
+        self.window.setWindowTitle(f"{path.name} — {PROG}")
+        QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)
+        QApplication.processEvents(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents)
+        try:
+            yield
+        finally:
+            QApplication.restoreOverrideCursor()
+            for widget in (note, busy):
+                bar.removeWidget(widget)
+                widget.deleteLater()
+            self._update_title()
+
     def open_file(self, path: Path, *, raise_errors: bool = False) -> bool:
         """Open ``path`` after asking about unsaved edits; a bad file is reported in a dialog
         (or raised as StructureError with ``raise_errors``)."""
         if not self.maybe_save():
             return False
         try:
-            self.document.open(Path(path))
+            with self.opening(Path(path)):
+                self.document.open(Path(path))
         except StructureError as error:
             if raise_errors:
                 raise
@@ -99,15 +132,13 @@ class Files:
                                             f"Assemblies of {document.path.name}:", items, 0, False)
         if not chosen or not self.maybe_save():
             return False
-        path, source, model = document.path, document.source, document.model_number
-        QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)  # a capsid takes seconds
+        path, source, model, number = document.path, document.source, document.model_number, items.index(item) + 1
         try:
-            document.open_assembly(path, items.index(item) + 1, document.kind, model=model, data=source)
+            with self.opening(assembly_path(path, number)):  # a capsid takes seconds
+                document.open_assembly(path, number, document.kind, model=model, data=source)
         except StructureError as error:
             QMessageBox.critical(self.window, PROG, str(error))
             return False
-        finally:
-            QApplication.restoreOverrideCursor()
         return True
 
     def open_with(self, suffix: str, open_: Callable[[Path], object]) -> None:
