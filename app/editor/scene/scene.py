@@ -58,6 +58,8 @@ DEFAULT_LAYERS = {Layer.CARTOON, Layer.CURVE, Layer.CONTROL_POINTS, Layer.NUCLEI
                   Layer.VALIDATION, Layer.MEASUREMENTS, Layer.MODELS}
 MIN_SLAB = 0.5
 """Å: the nearest a clipping plane comes to the centre of the view."""
+VIEW_ANGLE = 30.0
+"""Degrees: the camera's field of view (VTK's), never changed: zooming moves the camera."""
 STILL_AFTER_MS = 250
 """Full detail comes back once nothing has moved for this long."""
 CAPTION_COLOUR = "#2b2f36"
@@ -192,8 +194,10 @@ class Scene(QObject):
         _, axes = np.linalg.eigh((ca - centre).T @ (ca - centre))  # by increasing extent; any number of atoms
         renderer = self.plotter.renderer
         renderer.camera_position = [tuple(centre + axes[:, 0] * 100.0), tuple(centre), tuple(axes[:, 1])]
+        renderer.camera.SetViewAngle(VIEW_ANGLE)  # (a zoom that narrowed it compounded with every reset)
         renderer.reset_camera(render=False)
-        renderer.camera.zoom(1.15)
+        renderer.camera.Dolly(1.15)  # a little closer than the fit: where the camera is says it all (sessions)
+        renderer.ResetCameraClippingRange()
 
     def frame_segment(self) -> None:
         """Centre the view on the edited segment and fit it in, looking from where the camera is

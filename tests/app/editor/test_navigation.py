@@ -340,3 +340,14 @@ def test_the_docks_fit_a_laptop_screen_without_scrolling(open_window: Opener, qt
         assert isinstance(area, QScrollArea)
         assert not area.verticalScrollBar().isVisible(), title
     assert window.plotter.width() >= 800 and window.plotter.height() >= 450
+
+
+def test_reset_view_twice_gives_the_same_view(window: MainWindow) -> None:
+    """Reset View fits the structure and comes a little closer by moving the camera, so a
+    second reset (or a session reopened) shows it at the same size (#35: 14% closer each time)."""
+    window.navigation.reset_view_action.trigger()
+    first = np.array([tuple(v) for v in window.plotter.camera_position])
+    window.plotter.camera.Zoom(1.5)  # whatever zoom came since
+    window.navigation.reset_view_action.trigger()
+    assert np.allclose([tuple(v) for v in window.plotter.camera_position], first, atol=1e-6)
+    assert window.plotter.camera.view_angle == 30.0

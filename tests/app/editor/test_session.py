@@ -82,6 +82,7 @@ def test_the_view_and_compared_structures_come_back(qtbot: QtBot, tmp_path: Path
     assert other.scene.layers == layers and other.scene.colouring is Colouring.CHAIN and other.scene.fat_helices
     assert other.scene.helix_cylinders and other.display_panel.cylinders.isChecked()
     assert np.allclose([tuple(v) for v in other.plotter.camera_position], camera)
+    assert other.plotter.camera.view_angle == window.plotter.camera.view_angle == 30.0  # the same zoom (#35)
     assert [(item.structure.entry_id, item.visible) for item in other.comparison.items] == [("1BMA", False)]
     before, after = window.comparison.items[0].fit, other.comparison.items[0].fit
     assert (after.tm_score, after.n_aligned) == (pytest.approx(before.tm_score), before.n_aligned)
