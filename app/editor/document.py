@@ -101,6 +101,8 @@ class Document(QObject):
         """A drag's undo step holds the edit followed by :func:`core.geometry.regularize.regularized`."""
         self.regularize_while_dragging = False
         """Every preview is regularized (40–110 ms a step on ubiquitin: off by default)."""
+        self.carry_ligands = True
+        """Edits carry the ligands and ions bound to the residues they move (see :meth:`set_carry_ligands`)."""
         self._curves: dict[int, LevelCurve] = {}
         self._preview: Edit | None = None
         self.measurements = Measurements(self)
@@ -308,6 +310,13 @@ class Document(QObject):
         """Show the level curve dragged at parameter ``u`` by ``displacement`` (Å) from the drag start."""
         self._preview_edit(lambda: self._model.tug(self.segment, self.shown_level(), u, displacement))
 
+    def set_carry_ligands(self, on: bool) -> None:
+        """Whether the ligands and ions bound to a residue move with it in the edits to come
+        (:meth:`core.protein.model.EditableModel.bound_ligands`)."""
+        self.carry_ligands = on
+        if self.model is not None:
+            self._model.carry_ligands = on
+
     def set_regularization(self, *, on_release: bool | None = None, while_dragging: bool | None = None) -> None:
         """Regularize drags when they end and/or at every preview (None: leave as it is)."""
         if on_release is not None:
@@ -402,6 +411,7 @@ class Document(QObject):
             self.measurements.replace([])  # (their rows name other atoms)
         self.undo_stack.clear()
         self.model = model
+        model.carry_ligands = self.carry_ligands
         rings = rings_per_residue(sum(len(ribbon.residue_u) for ribbon in model.ribbons))
         self.paths = [SegmentPath(ribbon, rings) for ribbon in model.ribbons]
         self.ca_rows = ca_rows(model.structure)

@@ -103,7 +103,8 @@ def regularized(model: EditableModel, edit: Edit, *, flank: int = FLANK, max_ite
 
     ``model`` may hold ``edit``'s old or new state (only ``edit.rows`` differ between the
     two). The result has the same segment, control points and old state; its residues and
-    rows add up to ``flank`` neighbours on each side, so undo restores everything.
+    rows add up to ``flank`` neighbours on each side, so undo restores everything; atoms the
+    edit moved outside them (the ligands it carried) keep its move.
     """
     segment = model.segments[edit.segment]
     ribbon = model.ribbons[edit.segment]
@@ -117,7 +118,10 @@ def regularized(model: EditableModel, edit: Edit, *, flank: int = FLANK, max_ite
     tangents = ribbon.space.evaluate(edit.new_points, u, 1)
     result = relax(model.structure, after, segment.residue_index[free], anchors, tangents, before,
                    max_iterations=max_iterations, schedule=schedule)
-    return Edit(edit.segment, edit.old_points, edit.new_points, free, result.rows, before[result.rows], result.coords)
+    rows = np.union1d(result.rows, edit.rows)  # (with the ligands the edit carried, as it moved them)
+    new = after[rows]
+    new[np.searchsorted(rows, result.rows)] = result.coords
+    return Edit(edit.segment, edit.old_points, edit.new_points, free, rows, before[rows], new)
 
 
 def regularize_region(

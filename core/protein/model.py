@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from core.curves.editing import move_control_point, tug_curve
 from core.protein.frames import remap_atoms
@@ -20,6 +21,9 @@ from core.protein.ribbon import Ribbon, RibbonKind, segment_ribbon
 from core.protein.structure import BackboneSegment, Structure
 from core.protein.writing import write_structure
 
+CARRY_DISTANCE = 4.0
+"""Å: a ligand or ion with an atom this near a residue's atom is bound to it (to the nearest such
+residue) and, while :attr:`EditableModel.carry_ligands` is on, rides with it as a rigid body."""
 NEGLIGIBLE_MOVE = 1e-6
 """Control-point changes up to this size (Å) move no residue: fractional-level edits have
 exponentially decaying tails over the whole segment that would otherwise remap it all."""
@@ -85,6 +89,9 @@ class EditableModel:
         self.kind = RibbonKind(kind)
         self.coords = np.array(structure.coords)
         self.ribbons = [segment_ribbon(s, self.kind, helix_offset) for s in structure.segments]
+        self.carry_ligands = True
+        """Whether the ligands and ions bound to a moved residue move with it (see :meth:`bound_ligands`)."""
+        self._bound = _bound_ligands(structure)
 
     @property
     def segments(self) -> tuple[BackboneSegment, ...]:
@@ -103,12 +110,24 @@ class EditableModel:
         delta = tug_curve(ribbon.fs_level(level), u, displacement, ribbon.level)
         return self.plan(segment, ribbon.points + delta)
 
+    def bound_ligands(self, segment: int) -> tuple[np.ndarray, np.ndarray]:
+        """The atom rows of the ligands and ions bound to residues of ``segment`` (see
+        :data:`CARRY_DISTANCE`) and, per row, the residue (within the segment) it rides with."""
+        return self._bound[segment]
+
     def plan(self, segment: int, new_points: np.ndarray) -> Edit:
         """The edit that gives segment ``segment`` the finest control points ``new_points``."""
         ribbon = self._ribbon(segment)
         new_ribbon = ribbon.with_points(new_points)
         residues = ribbon.residues_moved_by(np.abs(new_ribbon.points - ribbon.points).max(axis=1) > NEGLIGIBLE_MOVE)
         rows, owner = _residue_rows(self.segments[segment], residues)
+        if self.carry_ligands:
+            bound, host = self._bound[segment]
+            riding = np.isin(host, residues)
+            rows = np.concatenate([rows, bound[riding]])
+            owner = np.concatenate([owner, np.searchsorted(residues, host[riding])])
+            order = np.argsort(rows, kind="stable")
+            rows, owner = rows[order], owner[order]
         u = ribbon.residue_u[residues]
         old_coords = self.coords[rows]
         new_coords = remap_atoms(
@@ -147,3 +166,29 @@ def _residue_rows(segment: BackboneSegment, residues: np.ndarray) -> tuple[np.nd
     owner = np.repeat(np.arange(len(residues)), lengths)
     offsets = np.arange(lengths.sum()) - np.repeat(np.cumsum(lengths) - lengths, lengths)
     return starts[owner] + offsets, owner
+
+
+def _bound_ligands(structure: Structure) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per segment, the atom rows of the ligand and ion groups bound to it and the residue
+    (within the segment) each rides with: the residue of the backbone atom nearest to the
+    group, when that atom lies within :data:`CARRY_DISTANCE` of one of the group's atoms."""
+    empty = np.empty(0, dtype=np.int64)
+    bound: list[tuple[np.ndarray, np.ndarray]] = [(empty, empty)] * len(structure.segments)
+    ligand = np.flatnonzero(structure.atoms.category == "ligand")
+    polymer = np.flatnonzero(structure.atom_residue >= 0)
+    if not len(ligand) or not len(polymer):
+        return bound
+    distance, nearest = cKDTree(structure.coords[polymer]).query(structure.coords[ligand],
+                                                                 distance_upper_bound=CARRY_DISTANCE)
+    group_of = np.unique(structure.atoms.residue[ligand], return_inverse=True)[1]
+    order = np.lexsort((distance, group_of))  # group by group, the nearest atom first
+    closest = order[np.r_[True, np.diff(group_of[order]) != 0]]  # each group's atom nearest to the polymer
+    residue_row = np.where(np.isfinite(distance[closest]),
+                           structure.atom_residue[polymer[np.minimum(nearest[closest], len(polymer) - 1)]], -1)
+    host_row = residue_row[group_of]  # per ligand atom: the residue-table row it rides with, or -1
+    for k, segment in enumerate(structure.segments):
+        local = np.full(structure.n_residues, -1)
+        local[segment.residue_index] = np.arange(len(segment.residue_index))
+        host = np.where(host_row >= 0, local[np.maximum(host_row, 0)], -1)
+        bound[k] = (ligand[host >= 0], host[host >= 0])
+    return bound

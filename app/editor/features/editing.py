@@ -1,5 +1,5 @@
 """Editing: Edit ▸ Undo, Redo, Cancel Drag / Deselect, the drag modes (move a control point,
-tug the curve; also in the tool bar) and Regularize Region."""
+tug the curve; also in the tool bar), Regularize Region and Carry Bound Ligands."""
 
 from __future__ import annotations
 
@@ -44,6 +44,11 @@ class Editing(QObject):
         self.regularize_action.setToolTip("Ideal peptide junctions and no new clashes for the residues of the picked "
                                           "point and three on each side (one undo step)")
         self.regularize_action.setEnabled(False)
+        self.carry_action = menus.action("Carry &Bound Ligands", QKeySequence(), document.set_carry_ligands)
+        self.carry_action.setCheckable(True)
+        self.carry_action.setChecked(document.carry_ligands)
+        self.carry_action.setToolTip("A ligand or ion within 4 Å of a residue moves with the nearest such residue, "
+                                     "as a rigid body (untick: edits leave them where they are)")
         self.mode_actions = QActionGroup(window)
         for mode, key in ((Mode.POINT, "M"), (Mode.CURVE, "T")):
             action = menus.action(mode.value[0].upper() + mode.value[1:], QKeySequence(key),
@@ -53,7 +58,7 @@ class Editing(QObject):
             self.mode_actions.addAction(action)
         menus.add("undo", self.undo_action, self.redo_action, self.cancel_action)
         menus.add("mode", *self.mode_actions.actions())
-        menus.add("region", self.regularize_action)
+        menus.add("region", self.regularize_action, self.carry_action)
         menus.add_tools("undo", self.undo_action, self.redo_action)
         menus.add_tools("mode", *self.mode_actions.actions())
         document.picked.connect(self._update_regularize_action)

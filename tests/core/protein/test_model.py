@@ -151,3 +151,49 @@ def test_fractional_edits_stay_local():
     moved_curve = ribbon.with_points(edit.new_points).residue_points()
     still = np.setdiff1d(np.arange(len(full)), edit.residues)
     assert np.abs(moved_curve[still] - full[still]).max() < 1e-5
+
+
+def _distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.linalg.norm(a[:, None] - b[None], axis=-1)
+
+
+@pytest.mark.parametrize("shift", [(3.0, -2.0, 1.0), (-1.0, 4.0, 0.5)])
+def test_a_bound_ligand_rides_with_its_residue_as_a_rigid_body(shift: tuple[float, float, float]) -> None:
+    """Hemoglobin's α heme is bound to its proximal His87: an edit that moves His87 moves the
+    heme with it (every distance within the heme and to His87 kept), undo puts it back bit for
+    bit, and with carrying off it stays where it was."""
+    structure = read_structure(DATA / "4HHB.pdb.gz")
+    model = EditableModel(structure)
+    rows, host = model.bound_ligands(0)
+    his = structure.segments[0].labels.index("A:HIS87")
+    assert set(host) == {his} and set(structure.atoms.resname[rows]) == {"HEM"} and len(rows) == 43
+    his_rows = np.arange(structure.segments[0].atom_start[his], structure.segments[0].atom_stop[his])
+    ribbon = model.ribbons[0]
+    before = model.coords.copy()
+    edit = model.tug(0, ribbon.max_level - 2, float(ribbon.residue_u[his]), np.array(shift))
+    assert np.isin(rows, edit.rows).all() and np.array_equal(edit.rows, np.sort(edit.rows))
+    model.apply(edit)
+    heme, imidazole = model.coords[rows], model.coords[his_rows]
+    assert np.linalg.norm(heme - before[rows], axis=1).min() > 0.5  # it moved ...
+    np.testing.assert_allclose(_distances(heme, heme), _distances(before[rows], before[rows]), atol=1e-9)
+    np.testing.assert_allclose(_distances(heme, imidazole), _distances(before[rows], before[his_rows]), atol=1e-9)
+    model.revert(edit)
+    assert np.array_equal(model.coords, before)
+    model.carry_ligands = False
+    left = model.tug(0, ribbon.max_level - 2, float(ribbon.residue_u[his]), np.array(shift))
+    assert not np.isin(rows, left.rows).any() and np.array_equal(left.rows, edit.rows[~np.isin(edit.rows, rows)])
+
+
+@pytest.mark.parametrize("name", ["3PTB.pdb.gz", "4HHB.pdb.gz", "1ACB.pdb.gz"])
+def test_the_ligands_that_ride_are_those_within_4_angstroms(name: str) -> None:
+    """Each ligand or ion group with an atom within 4 Å of a backbone residue's atom rides, whole,
+    with one residue; the others and every water ride with nothing."""
+    structure = read_structure(DATA / name)
+    model = EditableModel(structure)
+    riding = np.concatenate([model.bound_ligands(k)[0] for k in range(len(structure.segments))])
+    atoms, polymer = structure.atoms, structure.coords[structure.atom_residue >= 0]
+    for group in np.unique(atoms.residue[atoms.category == "ligand"]):
+        rows = np.flatnonzero(atoms.residue == group)
+        near = _distances(structure.coords[rows], polymer).min() <= 4.0
+        assert np.isin(rows, riding).all() == near and (np.isin(rows, riding).any() == near), atoms.resname[rows[0]]
+    assert len(riding) == len(np.unique(riding)) and not (atoms.category[riding] == "water").any()

@@ -1,8 +1,11 @@
 """Ligands (balls and sticks, carbon in green: ``ligand_balls``, ``ligand_sticks``) and ions (a
 large ball each: ``ions``), two layers switched on their own; also drawn for a structure that
-is only viewed (no backbone). Edits move neither."""
+is only viewed (no backbone). An edit moves those bound to the residues it moves (see
+:meth:`core.protein.model.EditableModel.bound_ligands`)."""
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyvista as pv
@@ -10,6 +13,9 @@ import pyvista as pv
 from app.editor.scene import molecule
 from app.editor.scene.layers.base import SHINY, Layer, SceneLayer
 from app.editor.scene.layers.meshes import bond_lines, collapse, glyph_rows, glyphs, move_glyphs
+
+if TYPE_CHECKING:
+    from app.editor.document import Change
 
 LIGAND_ATOM_RADIUS = 0.35
 ION_RADIUS = 1.1
@@ -37,6 +43,14 @@ class LigandsLayer(SceneLayer):
 
     def atom_rows(self) -> np.ndarray:
         return self._rows
+
+    def update(self, change: Change) -> None:
+        moved = np.flatnonzero(np.isin(self._rows, change.rows))
+        if len(moved):
+            coords = self.document.model.coords
+            move_glyphs(self.meshes["ligand_balls"], moved, coords[self._rows[moved]])
+            if self.meshes["ligand_sticks"].n_points:
+                self.write("ligand_sticks", self._rows[moved], coords[self._rows[moved]])
 
     def conceal(self, chain: str) -> None:
         other = self.document.structure.atoms.chain != chain
@@ -68,6 +82,11 @@ class IonsLayer(SceneLayer):
 
     def atom_rows(self) -> np.ndarray:
         return self._rows
+
+    def update(self, change: Change) -> None:
+        moved = np.flatnonzero(np.isin(self._rows, change.rows))
+        if len(moved):
+            move_glyphs(self.meshes["ions"], moved, self.document.model.coords[self._rows[moved]])
 
     def conceal(self, chain: str) -> None:
         _conceal_glyphs(self.meshes["ions"], self.document.structure.atoms.chain[self._rows] != chain)
