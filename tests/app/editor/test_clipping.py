@@ -76,3 +76,16 @@ def test_rw_shows_the_layers_and_sets_the_slab_and_the_cylinders(open_window: Op
     assert window.scene.slab is None and not window.clipping.toggle_action.isChecked()
     rw.cylinders = True
     assert window.scene.helix_cylinders and rw.cylinders
+
+
+def test_back_faces_are_culled_unless_the_slab_cuts_the_ribbons_open(open_window: Opener, qtbot: QtBot) -> None:
+    """Culling halves the triangles the software renderer rasterizes (its memory on a capsid);
+    inside the slab a cut ribbon shows its inside, so both sides are drawn then."""
+    window = open_window("1UBQ.pdb.gz")
+    cartoon = window.scene.actors["cartoon"].GetProperty()
+    assert cartoon.GetBackfaceCulling()
+    for slab in (True, False):
+        frames = window.plotter.frames
+        window.clipping.toggle_action.trigger()
+        qtbot.waitUntil(lambda frames=frames: window.plotter.frames > frames)
+        assert (window.scene.slab is not None) == slab and cartoon.GetBackfaceCulling() != slab

@@ -73,6 +73,9 @@ class Stage(Protocol):
     @property
     def chains(self) -> Chains: ...
     @property
+    def slab(self) -> tuple[float, float] | None:
+        """The clipping slab (Å in front of and behind the centre of the view), or None."""
+    @property
     def moving(self) -> bool:
         """Whether something moves (the view is drawn with less detail)."""
 

@@ -88,6 +88,13 @@ def shift(rows: Rows, offset: int, n: int, width: int = 1) -> Rows:
     return ((offset + np.asarray(rows))[:, None] * width + np.arange(width)).ravel()
 
 
+def compact(mesh: pv.PolyData) -> pv.PolyData:
+    """``mesh`` with its faces stored in 32 bits (VTK's default is 64): half the memory of the
+    faces of a large ribbon."""
+    mesh.GetPolys().ConvertTo32BitStorage()
+    return mesh
+
+
 def cells(blocks: list[np.ndarray]) -> np.ndarray:
     """pyvista's flat cell array ``[n, i0, ..., n, j0, ...]`` from blocks of equal-size cells."""
     return np.concatenate([np.column_stack([np.full(len(b), b.shape[1]), b]).ravel() for b in blocks if len(b)])

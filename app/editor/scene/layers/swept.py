@@ -2,7 +2,7 @@
 the rings of :class:`~app.editor.scene.curves.SegmentPath`, with flat end caps.
 
 One mesh named as the layer (``tube``, ``cartoon``): ring vertices segment by segment, then
-the caps (two per segment). An edit sweeps again only the rings of the residues that moved.
+the caps (two per segment), its faces stored in 32 bits (:func:`~app.editor.scene.layers.meshes.compact`). An edit sweeps again only the rings of the residues that moved.
 While something moves (see :meth:`~app.editor.scene.scene.Scene.moved`) the layer is drawn
 from two other meshes cut from it: the edited segment's in full (``<name>_edited``) and the
 other segments' with a sixth of their vertices (``<name>_others``), whose vertices are copied
@@ -22,7 +22,7 @@ from app.editor.document import Change
 from app.editor.scene import tube
 from app.editor.scene.layers.base import SceneLayer, Stage
 from app.editor.scene.layers.chains import Others
-from app.editor.scene.layers.meshes import Rows, cells, collapse, shift, span
+from app.editor.scene.layers.meshes import Rows, cells, collapse, compact, shift, span
 
 SIDES = 12
 """Vertices per ring."""
@@ -63,7 +63,7 @@ class SweptLayer(SceneLayer):
         faces = [tube.tube_faces(p.n_rings, SIDES, self.ring_start[g] * SIDES) for g, p in enumerate(paths)]
         caps = [tube.cap_faces(SIDES, start + end * (SIDES + 1)) for start in self._cap_start for end in (0, 1)]
         n_vertices = n_ring_vertices + 2 * len(paths) * (SIDES + 1)
-        mesh = pv.PolyData(np.zeros((n_vertices, 3)), faces=cells(faces + caps))
+        mesh = compact(pv.PolyData(np.zeros((n_vertices, 3)), faces=cells(faces + caps)))
         mesh.point_data["Normals"] = np.zeros((n_vertices, 3))
         mesh.point_data.active_normals_name = "Normals"
         mesh.point_data["colours"] = np.zeros((n_vertices, 3), dtype=np.uint8)
@@ -74,6 +74,14 @@ class SweptLayer(SceneLayer):
         self.restore()
         self.recolour(self.scene.residue_colours())
         self.add(self.name, **STYLE)
+
+    def before_frame(self) -> None:
+        """Back faces are culled (half the triangles rasterized: the software renderer's memory
+        and time) except while the slab clips the view, where a cut ribbon shows its inside."""
+        cull = self.scene.slab is None
+        for name in self.names:
+            if name in self.actors:
+                self.actors[name].GetProperty().SetBackfaceCulling(cull)
 
     def hidden(self) -> bool:
         """Whether it is hidden, and so must be swept in full once shown (:meth:`show`)."""
@@ -186,7 +194,7 @@ class SweptLayer(SceneLayer):
         for name in self.moving_names:
             self._moving_rows[name] = rows[name]
             if self._moving_segment != segment or name not in self.meshes:
-                mesh = pv.PolyData(np.asarray(full.points)[rows[name]], faces=cells(faces[name]))
+                mesh = compact(pv.PolyData(np.asarray(full.points)[rows[name]], faces=cells(faces[name])))
                 for array in ("Normals", "colours"):
                     mesh.point_data[array] = np.asarray(full.point_data[array])[rows[name]]
                 mesh.point_data.active_normals_name = "Normals"
@@ -194,7 +202,7 @@ class SweptLayer(SceneLayer):
                     self.meshes[name].shallow_copy(mesh)
                 else:
                     self.meshes[name] = mesh
-                    self.add(name, **STYLE, culling="back")  # a third cheaper: no hidden side drawn
+                    self.add(name, **STYLE)
             else:
                 self._copy_moving(name, colours=True)
         self._moving_segment = segment
