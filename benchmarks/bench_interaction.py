@@ -1,7 +1,7 @@
 """End to end: a real Qt event sent to a real editor window, timed until its frame is drawn.
 
 Usage: ``xvfb-run -a python benchmarks/bench_interaction.py [--steps N] [--views KIND ...] [--shown REP ...]
-[STRUCTURE ...]`` (default: 1UBQ, 1AYE, 4YVS from tests/data, each in both 3D views: VTK's native window and
+[--assembly N] [STRUCTURE ...]`` (default: 1UBQ, 1AYE, 4YVS from tests/data, each in both 3D views: VTK's native window and
 pyvistaqt's OpenGL widget, and with the cartoon or the tube shown, side by side). Each event goes through Qt as the mouse or the
 keyboard sends it (QTest), and the clock stops once the event loop has nothing left to do,
 the render included; a counter on the render window says how many frames each event drew,
@@ -93,13 +93,16 @@ def _timed(app: QApplication, frames: Frames, send) -> tuple[float, float, int, 
             frames.compositions - composed)
 
 
-def measure(app: QApplication, path: Path, steps: int, view_kind: str, shown: str
+def measure(app: QApplication, path: Path, steps: int, view_kind: str, shown: str, assembly: int | None = None
             ) -> dict[str, list[tuple[float, float, int, int]]]:
-    """Times and frame counts of every kind of event on the structure at ``path``, in the 3D
-    view ``view_kind``, with the ribbon ``shown`` (:data:`SHOWN`)."""
+    """Times and frame counts of every kind of event on the structure at ``path`` (its biological
+    ``assembly`` if given), in the 3D view ``view_kind``, with the ribbon ``shown`` (:data:`SHOWN`)."""
     os.environ["RIBBONWAVE_VIEW"] = view_kind
     document = Document()
-    document.open(path)
+    if assembly is None:
+        document.open(path)
+    else:
+        document.open_assembly(path, assembly)
     window = MainWindow(document)
     window.resize(1400, 900)
     window.show()
@@ -163,6 +166,7 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=20)
     parser.add_argument("--views", nargs="+", choices=("native", "widget"), default=["native", "widget"])
     parser.add_argument("--shown", nargs="+", choices=tuple(SHOWN), default=list(SHOWN))
+    parser.add_argument("--assembly", type=int, help="open each structure's biological assembly N (e.g. 1)")
     args = parser.parse_args()
     app = QApplication.instance() or QApplication(sys.argv[:1])
     QSettings.setPath(QSettings.Format.NativeFormat, QSettings.Scope.UserScope, tempfile.mkdtemp())  # not the user's
@@ -170,10 +174,10 @@ def main() -> None:
           f"{'frames/event':>13} {'compositions/event':>19}")
     for name in args.structures:
         path = Path(name) if Path(name).exists() else DATA / name
-        entry = path.name.split('.')[0]
+        entry = path.name.split('.')[0] + ("" if args.assembly is None else f"-a{args.assembly}")
         for view_kind in args.views:
             for shown in args.shown:
-                results = measure(app, path, args.steps, view_kind, shown)
+                results = measure(app, path, args.steps, view_kind, shown, args.assembly)
                 for kind, samples in results.items():
                     times, drawing, counts, compositions = np.array(samples).T
                     composed = f"{np.mean(compositions):.2f}" if view_kind == "widget" else "-"
