@@ -73,12 +73,16 @@ def comparison_report(result: Comparison, label_a: str, label_b: str) -> dict:
         "pairing": result.pairing,
         "n_pairs": result.n_pairs,
         "rms_all": round(result.rms_all, 4),
-        "tm_score": round(result.tm_score, 4),
-        "tm_score_length": result.length_a,
-        "tm_score_d0": round(result.d0, 4),
-        "tm_score_note": "superposition on all paired Cα; normalised by the length of the first chain",
-        "tm_score_a": round(result.match.tm_score_a, 4),
+        "paired_tm_score": round(result.tm_score, 4),
+        "paired_tm_score_length": result.length_a,
+        "paired_tm_score_d0": round(result.d0, 4),
+        "paired_tm_score_note": "of the superposition on all paired Cα (rms_all), normalised by the length of the "
+                                "first chain; not the structural match's TM-score (tm_score)",
+        "tm_score": round(result.match.tm_score_a, 4),
         "tm_score_b": round(result.match.tm_score_b, 4),
+        "tm_score_note": "the structural match, as TM-align scores it: the TM-score of the pairs after TM-align's "
+                         "superposition search, normalised by the first chain (tm_score_b: by the second); "
+                         "TM-align's own figure when the pairing is by structure",
         "n_aligned": result.match.n_aligned,
         "rms_aligned": round(result.match.rms_aligned, 4),
         "identity": round(result.match.identity, 4),
@@ -99,10 +103,10 @@ def comparison_text(report: dict) -> str:
     lines = [
         f"{report['chain_a']} ({report['length_a']} residues) vs {report['chain_b']} ({report['length_b']} residues)",
         f"{report['n_pairs']} residue pairs by {report['pairing']}",
-        f"fit on all paired Cα: rms {report['rms_all']:.3f} Å; TM-score {report['tm_score']:.4f} (of this "
-        f"superposition, normalised by the length of the first chain, {report['tm_score_length']} residues; "
-        f"d0 = {report['tm_score_d0']:.2f} Å)",
-        f"structural match: TM-score {report['tm_score_a']:.4f} (normalised by the first chain, "
+        f"fit on all paired Cα: rms {report['rms_all']:.3f} Å; paired TM-score {report['paired_tm_score']:.4f} "
+        f"(of this superposition, normalised by the length of the first chain, {report['paired_tm_score_length']} "
+        f"residues; d0 = {report['paired_tm_score_d0']:.2f} Å)",
+        f"structural match: TM-score {report['tm_score']:.4f} (normalised by the first chain, "
         f"{report['length_a']} residues), {report['tm_score_b']:.4f} (by the second, {report['length_b']}); "
         f"{report['n_aligned']} aligned pairs, rms {report['rms_aligned']:.3f} Å, sequence identity "
         f"{100 * report['identity']:.1f}%",

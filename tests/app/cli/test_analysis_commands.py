@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import tmtools
 from matplotlib.image import imread
 
 from app.main import main
@@ -149,7 +150,8 @@ def test_compare_a_distant_homologue_by_structure_or_by_sequence(capsys):
         assert status == 0
         reports[pairing] = json.loads(out)
     assert reports["auto"]["pairing"] == "structure" and reports["alignment"]["pairing"] == "alignment"
-    assert reports["auto"]["tm_score"] > reports["alignment"]["tm_score"] + 0.1
+    assert reports["auto"]["paired_tm_score"] > reports["alignment"]["paired_tm_score"] + 0.1
+    assert reports["auto"]["tm_score"] == pytest.approx(0.602, abs=0.02)  # TM-align's (by structure)
     assert reports["auto"]["n_core"] > 2 * reports["alignment"]["n_core"]
 
 
@@ -198,11 +200,17 @@ def test_compare_json_fields(capsys):
                          "--depths", "2")
     report = json.loads(out)
     assert status == 0
-    for key in ("rms_all", "n_pairs", "rms_core", "n_core", "tm_score"):
+    for key in ("rms_all", "n_pairs", "rms_core", "n_core", "tm_score", "tm_score_b", "paired_tm_score"):
         assert key in report
+    assert "tm_score_a" not in report  # one TM-score by the first chain, TM-align's: the one named tm_score
     assert report["n_pairs"] == 247 and 0 < report["rms_core"] < report["rms_all"] < 3
-    assert 0.8 < report["tm_score"] <= 1 and report["tm_score_length"] == 247
-    assert "normalised by the length of the first chain" in report["tm_score_note"]
+    assert 0.8 < report["paired_tm_score"] <= 1 and report["paired_tm_score_length"] == 247
+    assert "normalised by the length of the first chain" in report["paired_tm_score_note"]
+    assert "TM-align" in report["tm_score_note"] and report["tm_score"] >= report["paired_tm_score"] - 1e-4
+    b, a = (next(s for s in read_structure(DATA / "1TIM.pdb.gz").segments if s.chain == c) for c in "BA")
+    judge = tmtools.tm_align(b.ca, a.ca, b.sequence, a.sequence)  # TM-align itself
+    assert report["tm_score"] == pytest.approx(judge.tm_norm_chain1, abs=0.02)
+    assert report["tm_score_b"] == pytest.approx(judge.tm_norm_chain2, abs=0.02)
     assert [(f["points"], f["every"], f["start"]) for f in report["fits"]] == (
         [("CA", 1, 1)] + [("CA", 4, s) for s in range(1, 5)] + [("C^r", 1, 1)] + [("C^r", 4, s) for s in range(1, 5)]
     )
@@ -224,7 +232,7 @@ def test_compare_never_fails_on_unrelated_chains(first, second, capsys):
     status, out, err = run(capsys, "compare", *files, "--steps", "4", "--depths", "2", "--json")
     assert status == 0 and "Traceback" not in err
     report = json.loads(out)
-    assert not report["same_fold"] and max(report["tm_score_a"], report["tm_score_b"]) < 0.5
+    assert not report["same_fold"] and max(report["tm_score"], report["tm_score_b"]) < 0.5
     assert 3 <= report["n_aligned"] <= min(report["length_a"], report["length_b"])
     assert report["rms_aligned"] > 0 and 0 <= report["identity"] < 0.5
 
@@ -253,7 +261,7 @@ def test_compare_of_one_fold_says_so(capsys):
     status, out, _ = run(capsys, "compare", DATA / "3PTB.pdb.gz", DATA / "3SGB.pdb.gz", "--chains", "A:E", "--json",
                          "--steps", "4", "--depths", "2")
     report = json.loads(out)
-    assert status == 0 and report["same_fold"] and report["tm_score_a"] == pytest.approx(0.602, abs=0.02)
+    assert status == 0 and report["same_fold"] and report["tm_score"] == pytest.approx(0.602, abs=0.02)
     assert report["n_aligned"] > 150 and report["identity"] < 0.3  # TM-align: 0.602, 168 pairs
 
 
