@@ -2,7 +2,7 @@
 separation on a labelled set.
 
 Usage: ``python benchmarks/bench_fold_search.py FOLDER [--queries N | --all] [--candidates C]
-[--aligned A] [--labelled FOLDER]``. Indexes every protein chain of the structures in FOLDER (as ``ribbonwave
+[--aligned A] [--labelled FOLDER]``, or ``... --scop FOLDER [--hits H] [--tm-align N]``. Indexes every protein chain of the structures in FOLDER (as ``ribbonwave
 index`` does), then takes N chains spread evenly over the index (``--all``: every chain; the
 exhaustive ranking of every chain against every chain takes hours on a small machine) as
 queries. Each query is searched (:func:`core.analysis.fold_search.search`: the descriptor
@@ -19,6 +19,13 @@ has ``cytochromes``, ``ldh`` (lactate/malate dehydrogenases) and ``trypsins``): 
 chain, the fraction of its 10 nearest chains by descriptor that are of its family, and how
 well the descriptor distances alone separate pairs of one family from pairs of two (the
 area under the ROC curve).
+
+``--scop FOLDER``: a labelled SCOP set laid out as the shared ``scop40-dev`` (``labels.tsv``,
+``queries.txt``, ``domains/``): Foldseek's measure, the share of each query's true positives
+(same family; same superfamily, other family; same fold, other superfamily) ranked before the
+first domain of another fold, averaged over the queries, for the descriptor ranking alone, the
+search (its ``--hits`` best, ``--candidates`` screened, ``--aligned`` aligned in full) and, for
+the first ``--tm-align N`` queries, exhaustive TM-align; and the CPU time per query.
 """
 
 from __future__ import annotations
@@ -32,7 +39,7 @@ import numpy as np
 import tmtools
 
 from app.cli.batch import structure_paths
-from core.analysis.fold_search import FoldIndex, descriptor_distances, index_path, merge, search
+from core.analysis.fold_search import FoldIndex, descriptor_distances, index_path, merge, search, sensitivity
 
 PDB_CHAINS = 600_000
 TOP = 10
@@ -120,16 +127,67 @@ def family_separation(folder: Path) -> None:
     print(f"  pairs of one family against pairs of two by descriptor distance: ROC AUC {auc:.3f}")
 
 
+LEVELS = ("family", "superfamily", "fold")
+
+
+def scop_sensitivity(folder: Path, candidates: int, aligned: int, hits: int, tm_align_queries: int) -> None:
+    """The table of the measure of ``folder``'s README (``labels.tsv``, ``queries.txt``, ``domains/``):
+    per method, family / superfamily / fold sensitivity to the first false positive and the CPU per query."""
+    table = {row[0]: row for row in (line.split("\t") for line in (folder / "labels.tsv").read_text().splitlines()[1:])}
+    paths = sorted((folder / "domains").glob("*.pdb.gz"))
+    index, seconds = build_index(paths)
+    names = [str(entry) for entry in index.entries]
+    labels = {level: np.array([table[name][2 + k] for name in names]) for k, level in enumerate(LEVELS)}
+    queries = [names.index(name) for name in (folder / "queries.txt").read_text().split()]
+    chains = [sequence(index, row) for row in range(len(index))]
+    print(f"{folder}: {len(index)} domains indexed in {seconds:.1f} s, {len(queries)} queries; sensitivity up to "
+          "the first false positive (another fold), family / superfamily / fold")
+    search(index, *chains[queries[0]], hits, candidates, aligned)  # loads the compiled kernels
+    methods = {
+        "descriptor ranking (all domains)": lambda row: np.argsort(
+            descriptor_distances(index.descriptors, index.descriptors[row]), kind="stable"),
+        f"search, {candidates} candidates, {aligned} aligned, {hits} hits": lambda row: np.array(
+            [hit.row for hit in search(index, *chains[row], hits, candidates, aligned)], dtype=np.int64),
+    }
+    if tm_align_queries:
+        methods["exhaustive TM-align (tmtools, by the query)"] = lambda row: np.argsort(-np.array(
+            [tmtools.tm_align(chains[row][0], other, chains[row][1], codes).tm_norm_chain1 for other, codes in chains]),
+            kind="stable")
+    print(f"{'method':<48}{'queries':>8}{'family':>8}{'superfam.':>10}{'fold':>7}{'CPU s/query':>13}")
+    for method, rank in methods.items():
+        asked = queries[:tm_align_queries] if method.startswith("exhaustive") else queries
+        scores, cpu = [], []
+        for row in asked:
+            start = time.process_time()
+            ranked = rank(row)
+            cpu.append(time.process_time() - start)
+            scores.append(sensitivity(ranked, *(labels[level] for level in LEVELS), row))
+        found = np.array([score for score in scores if score is not None])
+        print(f"{method:<48}{len(found):>8}" + "".join(f"{value:>{width}.3f}" for value, width in
+                                                      zip(found.mean(axis=0), (8, 10, 7), strict=True))
+              + f"{np.mean(cpu):>13.3f}", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("folder", type=Path)
+    parser.add_argument("folder", type=Path, nargs="?", help="structures to index (not with --scop)")
     parser.add_argument("--queries", type=int, default=8, help="query chains spread over the index (default 8)")
     parser.add_argument("--all", action="store_true", help="every chain of the index as a query")
     parser.add_argument("--candidates", type=int, default=60, help="chains screened per query (default 60)")
     parser.add_argument("--aligned", type=int, default=15, help="chains aligned in full per query (default 15)")
     parser.add_argument("--labelled", type=Path, help="a folder of family subfolders")
+    parser.add_argument("--scop", type=Path, metavar="FOLDER",
+                        help="a labelled SCOP set (labels.tsv, queries.txt, domains/): Foldseek's sensitivity table")
+    parser.add_argument("--hits", type=int, default=10, help="--scop: hits the search lists (default 10)")
+    parser.add_argument("--tm-align", type=int, default=0, metavar="N",
+                        help="--scop: also rank the first N queries by exhaustive TM-align (slow: about a minute each)")
     args = parser.parse_args()
     print(f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())} on {os.cpu_count()} cores")
+    if args.scop is not None:
+        scop_sensitivity(args.scop, args.candidates, args.aligned, args.hits, args.tm_align)
+        return
+    if args.folder is None:
+        parser.error("give a folder of structures, or --scop FOLDER")
     paths = structure_paths([args.folder])
     index, seconds = build_index(paths)
     print(f"indexed {len(index)} chains of {len(paths)} files in {seconds:.1f} s (one process); "

@@ -274,3 +274,20 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = 10, candi
                         int(index.lengths[row]), float(distance[row]), match))
     hits.sort(key=lambda hit: -hit.match.tm_score_a)
     return hits
+
+
+def sensitivity(ranked: np.ndarray, family: np.ndarray, superfamily: np.ndarray, fold: np.ndarray,
+                query: int) -> np.ndarray | None:
+    """Foldseek's measure of one search: per level (same family; same superfamily, other family;
+    same fold, other superfamily), the share of the query's true positives that ``ranked``
+    (rows, best first; the query itself ignored) lists before the first chain of another fold.
+    ``family``, ``superfamily`` and ``fold`` label every row; None when a level has no true positive."""
+    kinds = np.select([family == family[query], superfamily == superfamily[query], fold == fold[query]], [0, 1, 2], 3)
+    kinds[query] = -1
+    totals = np.bincount(kinds[kinds >= 0], minlength=4)[:3]
+    if not totals.all():
+        return None
+    listed = kinds[np.asarray(ranked)[np.asarray(ranked) != query]]
+    false = np.flatnonzero(listed == 3)
+    before = listed[:false[0]] if len(false) else listed
+    return np.bincount(before[before >= 0], minlength=4)[:3] / totals

@@ -17,6 +17,7 @@ from core.analysis.fold_search import (
     index_path,
     merge,
     search,
+    sensitivity,
 )
 from core.analysis.tm_align import screen
 from core.curves.wavelets import smooth
@@ -94,3 +95,18 @@ def test_the_index_file_round_trip_and_refusals(index, tmp_path) -> None:
     np.savez(tmp_path / "damaged.npz", **arrays)
     with pytest.raises(ValueError, match="damaged"):
         FoldIndex.read(tmp_path / "damaged.npz")
+
+
+def test_sensitivity_counts_true_positives_up_to_the_first_other_fold() -> None:
+    """Foldseek's measure on a hand-made ranking: the query (row 0) has 2 true positives at each
+    level; the first chain of another fold (row 6) stops the count."""
+    family = np.array(["a", "a", "a", "b", "c", "d", "x", "e"])
+    superfamily = np.array(["A", "A", "A", "A", "B", "C", "X", "A"])
+    fold = np.array(["F", "F", "F", "F", "F", "F", "Y", "F"])
+    # 7 and 3 are of the superfamily (other families); 4 and 5 of the fold (other superfamilies)
+    ranked = np.array([0, 1, 4, 7, 6, 2, 3, 5])  # the query itself first is ignored
+    assert np.allclose(sensitivity(ranked, family, superfamily, fold, 0), [1 / 2, 1 / 2, 1 / 2])
+    assert np.allclose(sensitivity(np.array([2, 1, 3, 7, 4, 5]), family, superfamily, fold, 0), [1, 1, 1])
+    assert np.allclose(sensitivity(np.array([6, 1, 2]), family, superfamily, fold, 0), [0, 0, 0])
+    assert np.allclose(sensitivity(np.array([1]), family, superfamily, fold, 0), [1 / 2, 0, 0])  # a short list
+    assert sensitivity(ranked, family, superfamily, np.where(fold == "F", "G", fold), 6) is None  # no true positive
