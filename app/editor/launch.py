@@ -212,10 +212,12 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
     from app.editor.scene.scene import Layer
 
     if args.recover:
-        left = journal.orphans(window.journal.folder)
+        left, _ = journal.sweep(window.journal.folder)
         if not left:
+            aside = sorted(path.name for path in window.journal.folder.glob(f"*{journal.SET_ASIDE}"))
             raise InputError(f"nothing to recover: no journal of an editor that did not close cleanly in "
-                             f"{window.journal.folder}")
+                             f"{window.journal.folder}" + (f" (kept there, unreadable here: {', '.join(aside)})"
+                                                            if aside else ""))
         try:
             print(f"{PROG}: {window.sessions.restore_journal(left[0])}", file=sys.stderr)
         except (OSError, records.RecordError, StructureError) as error:

@@ -113,7 +113,11 @@ class Sessions:
 
     def offer_recovery(self) -> None:
         """If an editor ended without closing cleanly, offer to restore its unsaved edits."""
-        left = journal.orphans(self.journal.folder)
+        left, aside = journal.sweep(self.journal.folder)
+        if aside:
+            QMessageBox.warning(self.window, PROG, f"{len(aside)} journal(s) of unsaved edits could not be read "
+                                "(written by a newer ribbonwave, or damaged) and are kept, not deleted: "
+                                + ", ".join(path.name for path in aside) + f" in {self.journal.folder}.")
         if not left:
             return
         buttons = QMessageBox.StandardButton

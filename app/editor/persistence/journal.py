@@ -27,6 +27,12 @@ from app.editor.document import Document
 from app.editor.persistence import recording, records
 
 SUFFIX = ".rwjournal"
+SET_ASIDE = ".unreadable"
+"""Added to the name of a journal that cannot be read (:func:`sweep`): kept for a newer
+ribbonwave or a person to recover, never swept again."""
+OPENING = ".opening"
+"""Added to the name of a journal while it is created, locked and given its header: no sweep
+sees it before its editor holds it."""
 SYNC_DELAY_MS = 500
 """A written record reaches the disk (fsync) this long after it was written, at most."""
 STATE_DELAY_MS = 500
@@ -141,14 +147,19 @@ class Journal(QObject):
         for again in itertools.count():  # a journal kept within the same second keeps its name
             self.path = self.folder / f"{stem}{f'-{again}' if again else ''}{SUFFIX}"
             try:
-                self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o600)
-                break
+                self._fd = os.open(self.path.with_name(self.path.name + OPENING),
+                                   os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_APPEND, 0o600)
             except FileExistsError:
                 continue
+            if not self.path.exists():
+                break
+            os.close(self._fd)
+            os.unlink(self.path.with_name(self.path.name + OPENING))
         fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # held while this editor runs
         document = self.document
         os.write(self._fd, records.MAGIC + records.encode(records.header(document.path, document.kind.value,
                                                                              document.source, document.model_number)))
+        os.rename(self.path.with_name(self.path.name + OPENING), self.path)  # (the lock goes with the file)
         self._mirror = []
 
     def _write(self, *entries: records.Record) -> None:
@@ -170,10 +181,17 @@ class Journal(QObject):
 
 
 def orphans(folder: Path | None = None) -> list[Path]:
-    """Journals left by editors that ended without closing cleanly, newest first (journals
-    that hold no undo step are deleted)."""
+    """Journals left by editors that ended without closing cleanly, newest first (see :func:`sweep`)."""
+    return sweep(folder)[0]
+
+
+def sweep(folder: Path | None = None) -> tuple[list[Path], list[Path]]:
+    """The journals left by editors that ended without closing cleanly, newest first, and those
+    set aside now: a journal nobody holds that holds no undo step is deleted; one whose steps
+    cannot be read (a newer format, a damaged header) is renamed with :data:`SET_ASIDE`, never
+    deleted."""
     folder = state_folder() if folder is None else Path(folder)
-    found = []
+    found, aside = [], []
     for path in folder.glob(f"*{SUFFIX}"):
         try:
             fd = os.open(path, os.O_RDONLY)
@@ -186,11 +204,16 @@ def orphans(folder: Path | None = None) -> list[Path]:
         finally:
             os.close(fd)
         try:
-            recording, _ = records.read(path)
-        except (OSError, records.RecordError):
-            recording = []
+            recording, damaged = records.read(path)
+        except OSError:
+            continue  # (unreadable now: left for the next sweep)
+        except records.RecordError:
+            recording, damaged = [], True
         if any(record.kind == "push" for record in recording):
             found.append(path)
+        elif damaged:  # (its steps may lie past the damage: a person or a newer version may restore them)
+            aside.append(path.with_name(path.name + SET_ASIDE))
+            path.rename(aside[-1])
         else:
             path.unlink(missing_ok=True)
-    return sorted(found, key=lambda p: p.stat().st_mtime, reverse=True)
+    return sorted(found, key=lambda p: p.stat().st_mtime, reverse=True), aside

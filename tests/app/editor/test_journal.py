@@ -259,3 +259,67 @@ def test_kill_9_at_any_moment_then_recover(tmp_path: Path, state_home: Path, aft
         assert (recovered_names, recovered_index) == (names, index - 1)
         assert np.array_equal(np.load(tmp_path / "redone.npy"), reported)
     assert list(state_home.glob("*.rwjournal")) == []  # restored, then discarded by the check script
+
+
+@pytest.mark.parametrize("damage", ["newer format", "bad header byte"])
+def test_a_journal_that_cannot_be_read_is_set_aside_never_deleted(qtbot: QtBot, damage: str,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    """A journal of a newer ribbonwave, or with a damaged header, may hold steps a person or a
+    newer version can restore: the start-up sweep renames it, keeps its bytes and says so (#37)."""
+    crashed = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    _edit(crashed, 3)
+    crashed.files.unattended = True
+    path = crashed.journal.path
+    crashed.close()
+    data = bytearray(path.read_bytes())
+    if damage == "newer format":
+        entries, _ = records.read(path)
+        entries[0].fields["version"] = records.VERSION + 1
+        data = bytearray(records.MAGIC + b"".join(records.encode(entry) for entry in entries))
+    else:
+        data[len(records.MAGIC) + 12] ^= 0xFF  # inside the header record: its CRC fails
+    path.write_bytes(bytes(data))
+    warned: list[str] = []
+    monkeypatch.setattr(QMessageBox, "warning", lambda parent, title, text, *args: warned.append(text))
+    window = _window(qtbot, DATA / "3PTB.pdb.gz")
+    window.sessions.offer_recovery()
+    kept = path.with_name(path.name + journal.SET_ASIDE)
+    assert not path.exists() and kept.read_bytes() == bytes(data)
+    assert len(warned) == 1 and kept.name in warned[0] and "kept, not deleted" in warned[0]
+    window.sessions.offer_recovery()  # set aside once: not swept, not announced again
+    assert kept.exists() and len(warned) == 1
+
+
+def test_a_new_journal_is_never_seen_by_a_sweep_before_it_is_held(qtbot: QtBot,
+                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    """Between its creation and its lock another editor's sweep used to find a journal with
+    no step and delete it (#37): it now gets its name only once locked and given its header."""
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    seen: list[list[Path]] = []
+    lock = journal.fcntl.flock
+
+    def sweep_first(fd: int, operation: int) -> None:  # another editor sweeps just before the lock
+        if not seen:
+            seen.append(sorted(window.journal.folder.iterdir()))
+            journal.orphans(window.journal.folder)
+        lock(fd, operation)
+
+    monkeypatch.setattr(journal.fcntl, "flock", sweep_first)
+    _edit(window, 3)
+    monkeypatch.setattr(journal.fcntl, "flock", lock)
+    assert seen and all(p.name.endswith(journal.OPENING) for p in seen[0])
+    assert window.journal.path.exists() and [r.kind for r in _journal_records(window)].count("push") == 1
+
+
+def test_recover_with_nothing_to_restore_names_the_journals_set_aside(qtbot: QtBot, state_home: Path,
+                                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    from app.main import main
+
+    assert main(["--recover"]) == 1
+    assert capsys.readouterr().err.strip().endswith(f"nothing to recover: no journal of an editor that did not "
+                                                    f"close cleanly in {state_home}")
+    state_home.mkdir(parents=True, exist_ok=True)
+    (state_home / f"journal-1{journal.SUFFIX}{journal.SET_ASIDE}").write_bytes(records.MAGIC + b"\0" * 9)
+    assert main(["--recover"]) == 1
+    assert capsys.readouterr().err.strip().endswith(f"(kept there, unreadable here: journal-1{journal.SUFFIX}"
+                                                    f"{journal.SET_ASIDE})")
