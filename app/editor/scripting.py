@@ -283,9 +283,10 @@ class EditorAPI:
         """Save as File ▸ Save As does: ``path`` becomes the document's file, the edits are saved."""
         return self._document.save(Path(path), overwrite=overwrite)
 
-    def save_session(self, path: str | Path) -> Path:
-        """Save the session (structure, undo history, view) to ``path`` (``.rwsession`` added if missing)."""
-        return self._editor.sessions.write_session(Path(path))
+    def save_session(self, path: str | Path, *, overwrite: bool = False) -> Path:
+        """Save the session (structure, undo history, view) to ``path`` (``.rwsession`` added if
+        missing); an existing file only with ``overwrite`` (else FileExistsError)."""
+        return self._editor.sessions.write_session(Path(path), overwrite=overwrite)
 
     def screenshot(self, path: str | Path, width: int | None = None, height: int | None = None, *,
                    supersample: int = 1, transparent: bool = False, overwrite: bool = False) -> Path:

@@ -8,6 +8,7 @@ restored document is journalled anew; compared structures are dropped first.
 
 from __future__ import annotations
 
+import errno
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -75,11 +76,15 @@ class Sessions:
         self.files.add_recent(Path(path))
         return True
 
-    def write_session(self, path: Path) -> Path:
-        """Save the session to ``path`` (``.rwsession`` added if missing); raises OSError."""
+    def write_session(self, path: Path, *, overwrite: bool = False) -> Path:
+        """Save the session to ``path`` (``.rwsession`` added if missing); an existing file only
+        with ``overwrite`` (else FileExistsError); raises OSError."""
         if self.document.model is None:
             raise RuntimeError("no structure is open")
         path = Path(path) if Path(path).name.endswith(session.SUFFIX) else Path(f"{path}{session.SUFFIX}")
+        if not overwrite and (path.exists() or path.is_symlink()):
+            raise FileExistsError(errno.EEXIST, "refusing to overwrite an existing file (overwrite=True replaces it)",
+                                  str(path))
         session.write(path, recording(self.document), self._view())
         return path
 
@@ -91,8 +96,13 @@ class Sessions:
                                               SESSION_FILTER)
         if not name:
             return False
+        path = Path(name) if name.endswith(session.SUFFIX) else Path(f"{name}{session.SUFFIX}")
+        buttons = QMessageBox.StandardButton
+        if path != Path(name) and path.exists() and QMessageBox.question(  # (the dialog asked about the name without it)
+                self.window, PROG, f"{path.name} exists. Replace it?", buttons.Yes | buttons.No) != buttons.Yes:
+            return False
         try:
-            self.write_session(Path(name))
+            self.write_session(path, overwrite=True)
         except OSError as error:
             QMessageBox.critical(self.window, PROG, f"cannot write {name}: {error.strerror or error}")
             return False

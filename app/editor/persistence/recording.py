@@ -56,7 +56,7 @@ def replay(document: Document, recording: list[records.Record]) -> None:
 
 
 def _restore_files(document: Document, state: dict) -> None:
-    """The clean position and the file names of an ``index`` record."""
+    """The clean position and the structure's file name of an ``index`` record."""
     stack = document.undo_stack
     index = stack.index()
     if state["clean"] >= 0:
@@ -66,4 +66,5 @@ def _restore_files(document: Document, state: dict) -> None:
         stack.resetClean()
     stack.setIndex(index)
     document.path = Path(state["path"])
-    document.save_path = None if state["save_path"] is None else Path(state["save_path"])
+    document.save_path = None  # Save writes without asking only where Save As chose in this run: a session
+    # (perhaps someone else's) or a journal never points it at a file ("save_path" is recorded for older readers)

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PySide6.QtWidgets import QFileDialog
+from PySide6.QtWidgets import QFileDialog, QMessageBox
 from pytestqt.qtbot import QtBot
 from test_window import _window
 
@@ -149,3 +149,48 @@ def test_the_file_menu_saves_and_opens_sessions(qtbot: QtBot, tmp_path: Path, mo
     window.rw.undo()
     window.sessions.open_session_action.trigger()  # the conftest answers 'Discard' to the unsaved edits
     assert np.array_equal(window.rw.coords(), coords) and window.rw.history()[1] == 1
+
+
+def test_a_session_never_points_save_at_a_file(qtbot: QtBot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A session records where its author saved; opened (by anyone, anywhere) its Save asks for
+    a name instead of writing there (#37: a shared session could overwrite any file)."""
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    precious = tmp_path / "precious.pdb"
+    precious.write_text("mine\n")
+    window.rw.move(5, [3.0, 0.0, 0.0])
+    window.document.save(precious, overwrite=True)  # the author's Save As there
+    window.rw.move(6, [0.0, 2.0, 0.0])
+    saved = window.sessions.write_session(tmp_path / "shared")
+    precious.write_text("mine\n")  # (the recipient's file of that name)
+    other = _window(qtbot, DATA / "3PTB.pdb.gz")
+    assert other.sessions.open_session(saved) and other.document.save_path is None
+    asked: list[str] = []
+
+    def cancel(parent: object, title: str, suggested: str, *args: object) -> tuple[str, str]:
+        asked.append(suggested)
+        return "", ""
+
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", cancel)
+    assert not other.files.save() and asked  # Save asked (and was cancelled)
+    assert precious.read_text() == "mine\n"
+
+
+def test_a_session_replaces_a_file_only_when_told(qtbot: QtBot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                  questions) -> None:
+    """rw.save_session, like every output of ribbonwave, refuses an existing file unless told to
+    replace it; the menu asks when it added the ending to the name it was given (#37)."""
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    window.rw.move(5, [3.0, 0.0, 0.0])
+    mine = tmp_path / "mine.rwsession"
+    mine.write_bytes(b"mine")
+    with pytest.raises(FileExistsError, match="refusing to overwrite"):
+        window.rw.save_session(tmp_path / "mine")
+    assert mine.read_bytes() == b"mine"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(tmp_path / "mine"), ""))
+    questions.answer = QMessageBox.StandardButton.No
+    assert not window.sessions.save_session() and questions.asked[-1] == "mine.rwsession exists. Replace it?"
+    assert mine.read_bytes() == b"mine"
+    questions.answer = QMessageBox.StandardButton.Yes
+    assert window.sessions.save_session() and mine.read_bytes().startswith(records.MAGIC)
+    assert window.rw.save_session(mine, overwrite=True) == mine
+    questions.answer = QMessageBox.StandardButton.Discard  # for the window's close after the test
