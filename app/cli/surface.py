@@ -21,6 +21,7 @@ from app.errors import InputError
 from app.polydata import scalar_style, to_polydata
 from core.protein.reading import read_atoms
 from core.protein.structure import AtomTable, StructureError
+from core.protein.writing import new_file_mode
 from core.surfaces.dna import ideal_bdna
 from core.surfaces.levelled import KINDS, UNITS, LevelledSurface, build_surface
 from core.surfaces.map_file import MAP_SUFFIXES, read_map
@@ -129,7 +130,7 @@ def _write(mesh: TriangleMesh, scalars: np.ndarray | None, colouring: str | None
             _render(polydata, scalars, colouring, tmp)
         else:
             polydata.save(tmp)
-        os.chmod(tmp, 0o644)
+        os.chmod(tmp, new_file_mode())
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):

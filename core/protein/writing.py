@@ -380,9 +380,18 @@ def _patched_atom_site(structure: Structure, coords: np.ndarray) -> str | None:
     return "".join(lines)
 
 
+def new_file_mode() -> int:
+    """The permissions a new file gets under the process's umask (0o644 under the usual 022,
+    0o600 under 077): a temporary file renamed into place is made with 0o600 whatever the umask."""
+    umask = os.umask(0o077)  # (os.umask can only be read by setting it; set back at once)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
 def atomic_write(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file next to ``path``, then rename it onto ``path``."""
-    mode = path.stat().st_mode & 0o777 if path.exists() else 0o644
+    """Write ``data`` to a temporary file next to ``path``, then rename it onto ``path`` (a new
+    file gets the permissions the umask allows, a replaced one keeps its own)."""
+    mode = path.stat().st_mode & 0o777 if path.exists() else new_file_mode()
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as out:

@@ -369,6 +369,24 @@ def test_existing_files_and_the_input_are_not_overwritten(tmp_path: Path) -> Non
     ]  # no temporary files left
 
 
+@pytest.mark.parametrize(("umask", "mode"), [(0o022, 0o644), (0o077, 0o600), (0o027, 0o640)])
+def test_a_new_file_gets_what_the_umask_allows_and_a_replaced_one_keeps_its_mode(tmp_path: Path, umask: int,
+                                                                                mode: int) -> None:
+    """Outputs are written to a temporary file and renamed: a new one takes the umask's
+    permissions (a private umask keeps the edits private, #37), a replaced one keeps its own."""
+    structure = read_structure(DATA / "1UBQ.pdb.gz")
+    before = os.umask(umask)
+    try:
+        new = write_structure(structure, structure.coords, tmp_path / "new.pdb")
+        old = tmp_path / "old.pdb"
+        old.write_text("old\n")
+        old.chmod(0o664)
+        write_structure(structure, structure.coords, old, overwrite=True)
+    finally:
+        os.umask(before)
+    assert new.stat().st_mode & 0o777 == mode and old.stat().st_mode & 0o777 == 0o664
+
+
 def test_failed_write_leaves_nothing_behind(tmp_path: Path) -> None:
     s = read("7Z9T.cif.gz")
     with pytest.raises(StructureError, match="chain name too long"):
