@@ -335,12 +335,19 @@ def _read_script(path: Path) -> str:
 
 def _run_script(window: MainWindow, path: Path, text: str) -> int:
     """Run ``text`` (the script at ``path``) with ``rw``; an exception prints the script's
-    traceback and gives exit status 1, ``sys.exit(n)`` gives ``n``."""
+    traceback and gives exit status 1, ``sys.exit(n)`` gives ``n`` (0 to 255; any other number
+    1, not what the operating system would keep of it: 256 would read as success), and
+    ``sys.exit(message)`` prints the message and gives 1, as Python does."""
     namespace = {"__name__": "__main__", "__file__": str(path), "rw": window.rw}
     try:
         exec(compile(text, str(path), "exec"), namespace)  # noqa: S102 (running the user's script is the point)
     except SystemExit as error:
-        return error.code if isinstance(error.code, int) else (0 if error.code is None else 1)
+        if error.code is None:
+            return 0
+        if isinstance(error.code, int):
+            return error.code if 0 <= error.code <= 255 else 1
+        print(error.code, file=sys.stderr)
+        return 1
     except BaseException as error:  # noqa: BLE001 (any failure of the script is reported, not raised)
         tb = error.__traceback__
         while tb is not None and tb.tb_frame.f_code.co_filename != str(path):

@@ -133,6 +133,19 @@ def test_a_failing_script_prints_its_traceback_and_exits_1(tmp_path: Path, capsy
     assert "cannot read" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(("ending", "status", "said"), [
+    ("sys.exit()", 0, ""), ("sys.exit(4)", 4, ""), ("sys.exit(256)", 1, ""), ("sys.exit(-1)", 1, ""),
+    ("sys.exit('the map is missing')", 1, "the map is missing"),
+])
+def test_a_script_exit_status_is_one_the_shell_reads_as_given(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                              ending: str, status: int, said: str) -> None:
+    """sys.exit(256) used to end the editor with status 0 (256 modulo 256), as a success (#37)."""
+    script = tmp_path / "ends.py"
+    script.write_text(f"import sys\nrw.quit(discard=True)\n{ending}\n")
+    assert main([str(DATA / "1UBQ.pdb.gz"), "--script", str(script)]) == status
+    assert capsys.readouterr().err.strip().endswith(said)
+
+
 def test_the_python_console_drives_the_editor(qtbot: QtBot) -> None:
     window = _window(qtbot, DATA / "1UBQ.pdb.gz")
     assert not window.console_dock.isVisible()
