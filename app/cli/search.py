@@ -108,7 +108,10 @@ def run_search(args: argparse.Namespace) -> int:
         raise InputError(str(error)) from None
     start = time.perf_counter()
     ca = np.concatenate([s.ca for s in segments])
-    hits = search(index, ca, "".join(s.sequence for s in segments), args.top, args.candidates, args.aligned)
+    try:
+        hits = search(index, ca, "".join(s.sequence for s in segments), args.top, args.candidates, args.aligned)
+    except ValueError as error:  # a chain of the index found damaged as it is read
+        raise InputError(f"{args.index}: {error}") from None
     seconds = time.perf_counter() - start
     report = {
         "query": f"{path} chain {chain}",

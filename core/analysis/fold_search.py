@@ -68,6 +68,8 @@ FORMAT = 2
 SCREEN_STEP = 4
 """The candidates of :func:`search` are screened by aligning every 4th Cα of each chain."""
 FIELDS = ("format", "entries", "chains", "paths", "lengths", "descriptors", "coordinates", "sequences")
+REBUILD = "index the files again (ribbonwave index FILE... -o DB --overwrite)"
+"""What a damaged or empty index asks for."""
 
 
 def curve_descriptor(ca: np.ndarray) -> np.ndarray:
@@ -127,9 +129,14 @@ class FoldIndex:
         return np.concatenate([[0], np.cumsum(self.lengths)[:-1]]).astype(np.int64)
 
     def chain(self, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """The Cα (float64) and one-letter codes of chain ``k``."""
+        """The Cα (float64) and one-letter codes of chain ``k``; ValueError where the file's
+        coordinates of it are not finite numbers (a damaged index: they are read only now)."""
         rows = slice(int(self.starts[k]), int(self.starts[k] + self.lengths[k]))
-        return np.asarray(self.coordinates[rows], dtype=np.float64), np.asarray(self.sequences[rows])
+        ca = np.asarray(self.coordinates[rows], dtype=np.float64)
+        if not np.isfinite(ca).all():
+            raise ValueError(f"a damaged fold index: chain {k} ({self.entries[k]}:{self.chains[k]}) has non-finite "
+                             f"coordinates; {REBUILD}")
+        return ca, np.asarray(self.sequences[rows])
 
     def to_bytes(self) -> bytes:
         """The index as an uncompressed ``.npz`` archive of plain arrays (no pickled objects), so
@@ -156,10 +163,15 @@ class FoldIndex:
             raise ValueError(f"{path}: not a ribbonwave fold index ({type(error).__name__}: {error})") from None
         index = cls(**arrays)
         n = len(index.entries)
+        if not n:
+            raise ValueError(f"{path}: a fold index of no chain; {REBUILD}")
         residues = int(index.lengths.sum())
         if (index.descriptors.shape != (n, DESCRIPTOR_SIZE) or len(index.lengths) != n or len(index.chains) != n
                 or len(index.coordinates) != residues or len(index.sequences) != residues):
-            raise ValueError(f"{path}: a damaged fold index (its arrays disagree)")
+            raise ValueError(f"{path}: a damaged fold index (its arrays disagree); {REBUILD}")
+        if (index.lengths < MIN_RESIDUES).any() or not np.isfinite(index.descriptors).all():
+            raise ValueError(f"{path}: a damaged fold index (chains shorter than {MIN_RESIDUES} residues or "
+                             f"descriptors that are not finite numbers); {REBUILD}")
         return index
 
 

@@ -121,3 +121,33 @@ def test_bad_input(argv, message, tmp_path, capsys):
     argv = [a.replace("{data}", str(DATA)).replace("{tmp}", str(tmp_path)) for a in argv]
     status, _, err = run(capsys, *argv)
     assert status == 1 and message in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(("damage", "message"), [
+    ("no chain", "a fold index of no chain"),
+    ("infinite descriptors", "descriptors that are not finite numbers"),
+    ("a chain of 0 residues", "chains shorter than 20 residues"),
+    ("infinite coordinates", "non-finite coordinates"),
+    ("lengths that disagree", "its arrays disagree"),
+])
+def test_a_damaged_index_asks_to_be_built_again(index_file, tmp_path, capsys, damage, message):
+    """Each of these gave a traceback (ZeroDivisionError, IndexError, ...); each now says what is
+    wrong and how to rebuild the index (#37)."""
+    from core.analysis.fold_search import FORMAT
+
+    index = read_index(index_file)
+    arrays = {name: np.array(getattr(index, name)) for name in FIELDS[1:]}
+    if damage == "no chain":
+        arrays = {name: array[:0] for name, array in arrays.items()}
+    elif damage == "infinite descriptors":
+        arrays["descriptors"][3] = np.inf
+    elif damage == "a chain of 0 residues":
+        arrays["lengths"][1], arrays["lengths"][2] = 0, arrays["lengths"][1] + arrays["lengths"][2]
+    elif damage == "infinite coordinates":
+        arrays["coordinates"][:] = np.inf
+    else:
+        arrays["lengths"][0] += 5
+    damaged = tmp_path / "damaged.npz"
+    np.savez(damaged, format=np.array(FORMAT), **arrays)
+    status, _, err = run(capsys, "search", DATA / "3PTB.pdb.gz", damaged)
+    assert status == 1 and message in err and "index the files again" in err and "Traceback" not in err
