@@ -43,6 +43,10 @@ from core.analysis.database import (
     rms_crossing,
 )
 
+NAMES = "backslashreplace"
+"""How a file name that is not UTF-8 is written in a CSV: its odd bytes as Python names them
+(the byte 0xE9 of ``ub?.pdb`` as ``ub\\udce9.pdb``), so every output stays UTF-8."""
+
 SUMMARY_COLUMNS = ("ribbon", "mode", "depth", "class", "n_residues", "rms", "sd")
 RESIDUE_COLUMNS = ("file", "entry", "chain", "curve", "resseq", "icode", "resname", "ss", "class")
 OUTPUTS = ("residues.csv", "summary.csv", "skipped.csv", "fig7.png")
@@ -89,14 +93,14 @@ def run_analyze(args: argparse.Namespace) -> int:
     _prepare_output(args.output, args.overwrite)
     pooled, skipped = PooledStatistics(options), []
     waiting: dict[int, Outcome] = {}  # finished out of order
-    with (_staging(args.output) as staging, (staging / "residues.csv").open("w", encoding="utf-8") as table,
+    with (_staging(args.output) as staging, (staging / "residues.csv").open("w", encoding="utf-8", errors=NAMES) as table,
           tqdm(total=len(paths), unit="file", desc="analysing", file=sys.stderr, mininterval=0.5) as progress):
         table.write(",".join(RESIDUE_COLUMNS + tuple(c.name for c in options.columns)) + "\n")
         task = functools.partial(analyse_file, options=options)
         for index, (result, lines) in run_tasks(task, paths, args.jobs, args.scheduler, _failed_file):
             progress.update()
             if isinstance(result, SkippedFile):
-                progress.write(f"skipped {result.path}: {result.reason}", file=sys.stderr)
+                progress.write(f"skipped {_named(result.path)}: {result.reason}", file=sys.stderr)
             waiting[index] = result, lines
             while (pooled.n_files + len(skipped)) in waiting:  # keep the files in input order
                 ready, lines = waiting.pop(pooled.n_files + len(skipped))
@@ -109,7 +113,8 @@ def run_analyze(args: argparse.Namespace) -> int:
         rows = pooled.rows()
         (staging / "summary.csv").write_text(summary_csv(rows), encoding="utf-8")
         (staging / "skipped.csv").write_text(
-            _csv_text([("file", "reason")] + [(_cell(str(s.path)), _cell(s.reason)) for s in skipped]), encoding="utf-8")
+            _csv_text([("file", "reason")] + [(_cell(str(s.path)), _cell(s.reason)) for s in skipped]), encoding="utf-8",
+            errors=NAMES)
         plot_fig7(rows, staging / "fig7.png")
         for name in OUTPUTS:  # all four at once, at the end: a killed run leaves the old set
             os.replace(staging / name, args.output / name)
@@ -282,6 +287,11 @@ def _field(text: str) -> str:
     if any(c in text for c in ',"\r\n'):
         return '"' + text.replace('"', '""') + '"'
     return text
+
+
+def _named(path: Path) -> str:
+    """``path`` as text that any stream takes (a byte that is not UTF-8 escaped, see :data:`NAMES`)."""
+    return str(path).encode("utf-8", NAMES).decode("utf-8")
 
 
 def _cell(text: str) -> str:

@@ -2,6 +2,7 @@
 
 import csv
 import json
+import os
 import re
 import shutil
 import socket
@@ -451,3 +452,17 @@ def test_a_server_that_is_not_a_scheduler_fails_within_the_timeout(reply, messag
     server.close()
     for connection in held:
         connection.close()
+
+
+def test_analyze_reads_and_names_files_whose_names_are_not_utf8(tmp_path, capsys):
+    """A file name of Latin-1 bytes (ub\\xe9.pdb.gz) gave a UnicodeEncodeError at the first row
+    (#37); it is analysed and named in UTF-8 outputs, its odd byte escaped, and so is a bad one."""
+    folder = tmp_path / "in"
+    folder.mkdir()
+    shutil.copy(DATA / "1UBQ.pdb.gz", os.fsdecode(bytes(folder) + b"/ub\xe9.pdb.gz"))
+    Path(os.fsdecode(bytes(folder) + b"/bad\xe9.pdb")).write_text("not a structure\n")
+    status, _, err = run(capsys, "analyze", folder, "-o", tmp_path / "out", "--jobs", "1")
+    assert status == 0 and "Traceback" not in err
+    rows = (tmp_path / "out" / "residues.csv").read_text(encoding="utf-8").splitlines()
+    assert len(rows) == 77 and rows[1].startswith(f"{folder}/ub\\udce9.pdb.gz,1UBQ,A,")
+    assert "bad\\udce9.pdb" in (tmp_path / "out" / "skipped.csv").read_text(encoding="utf-8")
