@@ -86,6 +86,12 @@ def _attach_negative_vectors(args: list[str]) -> list[str]:
     return glued
 
 
+def printable(message: str) -> str:
+    """``message`` with its control characters escaped (``\\x1b``, ``\\r``): a file's bytes quoted
+    in a message (an escape sequence in a broken line) never act on the terminal."""
+    return "".join(c if c.isprintable() or c == "\n" else repr(c)[1:-1] for c in message)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``ribbonwave`` with ``argv`` (default: ``sys.argv[1:]``) and return the exit status."""
     args_list = _attach_negative_vectors(list(sys.argv[1:] if argv is None else argv))
@@ -95,7 +101,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return args.run(args)
     except InputError as error:
-        print(f"{PROG}: error: {error}", file=sys.stderr)
+        print(f"{PROG}: error: {printable(str(error))}", file=sys.stderr)
         return 1
     except BrokenPipeError:  # output piped into a reader that stopped early (e.g. head)
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

@@ -228,3 +228,13 @@ def test_edit_of_one_model_leaves_every_other_model_as_read(capsys, tmp_path, na
     written = out.read_text().splitlines()
     assert len(written) == len(original)
     assert sum(a != b for a, b in zip(written, original)) == moved.sum()  # the moved atoms' lines alone
+
+
+def test_a_message_quoting_a_name_never_sends_it_raw_to_the_terminal(tmp_path, capsys):
+    """A file named with an escape sequence (as a folder of downloads may hold) is quoted in the
+    message escaped, so it cannot clear or recolour the user's terminal (#37)."""
+    path = tmp_path / "\x1b[2J\x1b[31mentry.pdb"
+    path.write_text("not a structure\n")
+    assert main(["info", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "\x1b" not in err and "\\x1b[2J\\x1b[31mentry.pdb" in err and "not a structure file" in err
