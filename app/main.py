@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from typing import NamedTuple
 
 from app import PROG
-from app.errors import InputError
+from app.errors import InputError, printable
 
 DEFAULT_COMMAND = "open"
 VECTOR_OPTIONS = ("--move", "--core")
@@ -84,12 +84,6 @@ def _attach_negative_vectors(args: list[str]) -> list[str]:
         else:
             glued.append(arg)
     return glued
-
-
-def printable(message: str) -> str:
-    """``message`` with its control characters escaped (``\\x1b``, ``\\r``): a file's bytes quoted
-    in a message (an escape sequence in a broken line) never act on the terminal."""
-    return "".join(c if c.isprintable() or c == "\n" else repr(c)[1:-1] for c in message)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

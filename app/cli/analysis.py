@@ -25,7 +25,7 @@ from tqdm import tqdm
 
 from app.arguments import bounded
 from app.cli.batch import batch_arguments, run_tasks, structure_paths
-from app.errors import InputError
+from app.errors import InputError, printable
 from core.analysis.database import (
     CLASSES,
     MODES,
@@ -290,8 +290,9 @@ def _field(text: str) -> str:
 
 
 def _named(path: Path) -> str:
-    """``path`` as text that any stream takes (a byte that is not UTF-8 escaped, see :data:`NAMES`)."""
-    return str(path).encode("utf-8", NAMES).decode("utf-8")
+    """``path`` as text that any stream takes and no terminal acts on (a byte that is not UTF-8
+    escaped as :data:`NAMES` says, a control character as :func:`app.errors.printable` does)."""
+    return printable(str(path).encode("utf-8", NAMES).decode("utf-8"))
 
 
 def _cell(text: str) -> str:

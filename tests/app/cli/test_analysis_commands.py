@@ -461,8 +461,10 @@ def test_analyze_reads_and_names_files_whose_names_are_not_utf8(tmp_path, capsys
     folder.mkdir()
     shutil.copy(DATA / "1UBQ.pdb.gz", os.fsdecode(bytes(folder) + b"/ub\xe9.pdb.gz"))
     Path(os.fsdecode(bytes(folder) + b"/bad\xe9.pdb")).write_text("not a structure\n")
+    (folder / "\x1b[2Jworse.pdb").write_text("not a structure\n")  # a name that would clear the terminal
     status, _, err = run(capsys, "analyze", folder, "-o", tmp_path / "out", "--jobs", "1")
-    assert status == 0 and "Traceback" not in err
+    assert status == 0 and "Traceback" not in err and "\x1b" not in err and "skipped" in err
+    assert "\\x1b[2Jworse.pdb" in err
     rows = (tmp_path / "out" / "residues.csv").read_text(encoding="utf-8").splitlines()
     assert len(rows) == 77 and rows[1].startswith(f"{folder}/ub\\udce9.pdb.gz,1UBQ,A,")
     assert "bad\\udce9.pdb" in (tmp_path / "out" / "skipped.csv").read_text(encoding="utf-8")
