@@ -99,10 +99,7 @@ def measure(app: QApplication, path: Path, steps: int, view_kind: str, shown: st
     ``assembly`` if given), in the 3D view ``view_kind``, with the ribbon ``shown`` (:data:`SHOWN`)."""
     os.environ["RIBBONWAVE_VIEW"] = view_kind
     document = Document()
-    if assembly is None:
-        document.open(path)
-    else:
-        document.open_assembly(path, assembly)
+    document.open(path, assembly=assembly)
     window = MainWindow(document)
     window.resize(1400, 900)
     window.show()

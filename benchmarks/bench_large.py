@@ -38,10 +38,7 @@ from PySide6.QtCore import Qt
 app = QApplication([])
 from app.editor.main_window import MainWindow
 window = MainWindow()
-if assembly:
-    window.document.open_assembly(path, assembly)
-else:
-    window.document.open(path)
+window.document.open(path, assembly=assembly or None)
 window.show()
 QTest.qWaitForWindowExposed(window)
 view = window.plotter

@@ -146,16 +146,6 @@ def startup(python: str, path: Path, env: dict[str, str]) -> dict[str, float]:
     return {phase: figures[phase] for phase in PHASES}
 
 
-def memory(python: str, path: Path, env: dict[str, str], assembly: str | None = None) -> float:
-    """Peak resident memory (MiB) of PyMOL once it has loaded ``path`` (its ``assembly`` if given) and drawn it."""
-    return measure(python, path, env, assembly)["memory"]
-
-
-def rotation(python: str, path: Path, env: dict[str, str], frames: int = 20, assembly: str | None = None) -> float:
-    """Median seconds per frame while PyMOL turns ``path`` (its ``assembly`` if given) 5 degrees a frame."""
-    return measure(python, path, env, assembly, frames)["frame"]
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("structure", type=Path)

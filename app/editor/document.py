@@ -28,7 +28,7 @@ from PySide6.QtGui import QUndoStack
 
 from app.editor.commands import EditCommand
 from app.editor.measurements import Measurements
-from app.editor.scene.curves import LevelCurve, SegmentPath, rings_per_residue
+from app.editor.scene.curves import LevelCurve, SegmentPath, segment_paths
 from core.geometry.regularize import FLANK, regularize_region, regularized
 from core.protein.assembly import assembly_path, assembly_text
 from core.protein.model import Edit, EditableModel
@@ -180,12 +180,6 @@ class Document(QObject):
         """Residue labels of ``segment`` (default: the current one), e.g. ``'A:LYS48'``."""
         return self.structure.segments[self.segment if segment is None else segment].labels
 
-    def segment_label(self, segment: int) -> str:
-        """E.g. ``'A  MET1–GLY76 (76 residues)'``."""
-        labels = self.labels(segment)
-        chain = self.structure.segments[segment].chain
-        return f"{chain}  {labels[0].split(':')[1]}–{labels[-1].split(':')[1]} ({len(labels)} residues)"
-
     def residue_range(self, residues: np.ndarray, segment: int | None = None) -> str:
         """E.g. ``'A:LYS6–A:THR9'`` (or ``'none'``)."""
         if len(residues) == 0:
@@ -197,24 +191,21 @@ class Document(QObject):
     # ------------------------------------------------------------------ mutators
 
     def open(self, path: Path, kind: RibbonKind | str = RibbonKind.PEPTIDE, data: bytes | None = None,
-             model: int = 1) -> None:
+             model: int = 1, assembly: int | None = None) -> None:
         """Read model ``model`` (1 .. n, in file order) of ``path`` (or of its content ``data``,
         already read) and make it the document (raises :class:`core.protein.structure.StructureError`).
-        A structure without protein opens for viewing only (see :attr:`editable`)."""
+        A structure without protein opens for viewing only (see :attr:`editable`). With
+        ``assembly``, its biological assembly of that number (from 1), built from that model, is
+        the document, as the mmCIF file :func:`~core.protein.assembly.assembly_path` names."""
         data = read_bytes(path) if data is None else data
+        if assembly is not None:
+            data = assembly_text(path, data, number=assembly, model=model).encode()
+            path, model = assembly_path(path, assembly), 1
         self._set_model(EditableModel(read_structure(path, data, model=model, require_protein=False), kind))
         self.path = Path(path)
         self.source = data
         self.save_path = None
         self.fileChanged.emit()
-
-    def open_assembly(self, path: Path, number: int, kind: RibbonKind | str = RibbonKind.PEPTIDE,
-                      model: int = 1, data: bytes | None = None) -> None:
-        """Open biological assembly ``number`` (from 1) of model ``model`` of ``path`` (or of its
-        content ``data``), as the mmCIF file :func:`~core.protein.assembly.assembly_path` names
-        (written only when saved)."""
-        text = assembly_text(path, read_bytes(path) if data is None else data, number=number, model=model)
-        self.open(assembly_path(path, number), kind, data=text.encode())
 
     def set_kind(self, kind: RibbonKind | str) -> None:
         """Switch between the peptide-plane and the Cα ribbon; only without edits to undo."""
@@ -286,16 +277,6 @@ class Document(QObject):
         if not np.array_equal(rows, self.selection):
             self.selection = rows
             self.selectionChanged.emit()
-
-    def row_label(self, row: int) -> str:
-        """The label of residue-table row ``row``, e.g. ``'A:LYS48'``."""
-        segment = self.structure.segments[self.segment_of(row)]
-        return segment.labels[row - int(segment.residue_index[0])]
-
-    def segment_of(self, row: int) -> int:
-        """The segment holding residue-table row ``row``."""
-        starts = [s.residue_index[0] for s in self.structure.segments]
-        return int(np.searchsorted(starts, row, side="right") - 1)
 
     @property
     def dragging(self) -> bool:
@@ -412,8 +393,7 @@ class Document(QObject):
         self.undo_stack.clear()
         self.model = model
         model.carry_ligands = self.carry_ligands
-        rings = rings_per_residue(sum(len(ribbon.residue_u) for ribbon in model.ribbons))
-        self.paths = [SegmentPath(ribbon, rings) for ribbon in model.ribbons]
+        self.paths = segment_paths(model.ribbons)
         self.ca_rows = ca_rows(model.structure)
         longest = int(np.argmax([len(s) for s in model.structure.segments])) if model.ribbons else 0
         self.segment = segment if keep_view and segment < len(model.ribbons) else longest

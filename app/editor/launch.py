@@ -231,10 +231,7 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
             raise InputError(str(error)) from error
     else:
         try:
-            if args.assembly is None:
-                window.document.open(args.file, args.ribbon, model=args.model)
-            else:
-                window.document.open_assembly(args.file, args.assembly, args.ribbon, model=args.model)
+            window.document.open(args.file, args.ribbon, model=args.model, assembly=args.assembly)
         except StructureError as error:
             raise InputError(str(error)) from error
         if args.file != DEFAULT_STRUCTURE:

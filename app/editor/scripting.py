@@ -112,7 +112,7 @@ class EditorAPI:
     def selection(self) -> list[str]:
         """Labels of the selected residues, e.g. ``['A:LYS48']``."""
         document = self._document
-        return [document.row_label(int(row)) for row in document.selection]
+        return [document.structure.residue_label(int(row)) for row in document.selection]
 
     def go_to(self, residues: str) -> list[str]:
         """Select ``residues`` (``'A:45'``, ``'45'`` in the edited chain, ``'A:40-50'``; ChimeraX's
@@ -120,7 +120,7 @@ class EditorAPI:
         centre the view on them, as Go to Residue (Ctrl+L) does; their chain becomes the edited
         segment. Returns their labels (ValueError for a residue that does not exist)."""
         document = self._document
-        return [document.row_label(int(row)) for row in self._editor.navigation.go_to(residues)]
+        return [document.structure.residue_label(int(row)) for row in self._editor.navigation.go_to(residues)]
 
     def measure(self, *atoms: int | str) -> float | None:
         """Label one atom (or, named without an atom, ``'A:48'``, its residue), or measure the

@@ -50,11 +50,11 @@ class StatusBar:
             labels["level"].clear()
             labels["pick"].setText(document.read_only_reason)
             return
-        labels["segment"].setText(f"chain {document.segment_label(document.segment)}")
+        labels["segment"].setText(f"chain {document.structure.segments[document.segment].summary}")
         labels["level"].setText(f"level {document.shown_level():.2f} / {document.max_level:.2f}")
         pick = document.pick
         if len(document.selection) and pick is None:
-            first, last = (document.row_label(int(r)) for r in document.selection[[0, -1]])
+            first, last = (document.structure.residue_label(int(r)) for r in document.selection[[0, -1]])
             labels["pick"].setText(f"selected {first if first == last else f'{first}–{last}'} "
                                    f"({len(document.selection)} residues); Esc clears")
             return

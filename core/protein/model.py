@@ -186,9 +186,8 @@ def _bound_ligands(structure: Structure) -> list[tuple[np.ndarray, np.ndarray]]:
     residue_row = np.where(np.isfinite(distance[closest]),
                            structure.atom_residue[polymer[np.minimum(nearest[closest], len(polymer) - 1)]], -1)
     host_row = residue_row[group_of]  # per ligand atom: the residue-table row it rides with, or -1
-    for k, segment in enumerate(structure.segments):
-        local = np.full(structure.n_residues, -1)
-        local[segment.residue_index] = np.arange(len(segment.residue_index))
-        host = np.where(host_row >= 0, local[np.maximum(host_row, 0)], -1)
-        bound[k] = (ligand[host >= 0], host[host >= 0])
+    riding = ligand[host_row >= 0]
+    segment, host = structure.residue_place(host_row[host_row >= 0])
+    for k in np.unique(segment).tolist():
+        bound[k] = (riding[segment == k], host[segment == k])
     return bound

@@ -36,7 +36,7 @@ from pathlib import Path
 
 import gemmi
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 MAX_CA_STEP = 4.2
 """Largest Cα–Cα distance (Å) between consecutive residues of one segment."""
@@ -108,6 +108,11 @@ class BackboneSegment:
     def sequence(self) -> str:
         """One-letter codes of the residues (modified ones as their parent, 'X' if unknown)."""
         return "".join(_one_letter(name) for name in self.resname)
+
+    @property
+    def summary(self) -> str:
+        """E.g. ``'A  MET1–GLY76 (76 residues)'``."""
+        return f"{self.chain}  {self.labels[0].split(':')[1]}–{self.labels[-1].split(':')[1]} ({len(self)} residues)"
 
 
 def _one_letter(name: str) -> str:
@@ -235,6 +240,18 @@ class Structure:
     def n_residues(self) -> int:
         """Rows of the residue table (backbone residues of all segments)."""
         return sum(len(s) for s in self.segments)
+
+    def residue_label(self, row: int) -> str:
+        """The label of residue-table row ``row``, e.g. ``'A:LYS48'``."""
+        segment, index = self.residue_place(row)
+        return self.segments[int(segment)].labels[int(index)]
+
+    def residue_place(self, rows: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """The segment holding each residue-table row of ``rows`` and the row's index within it
+        (the table lists the segments' residues segment after segment)."""
+        starts = np.array([int(s.residue_index[0]) for s in self.segments], dtype=np.int64)
+        segment = np.searchsorted(starts, rows, side="right") - 1
+        return segment, np.asarray(rows) - starts[segment]
 
 
 def ca_rows(structure: Structure) -> np.ndarray:

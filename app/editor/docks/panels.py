@@ -124,7 +124,7 @@ class RibbonDimensionPanel(QWidget):
         structure = document.structure
         with QSignalBlocker(self.segment), QSignalBlocker(self.kind), QSignalBlocker(self.model_number):
             self.segment.clear()
-            self.segment.addItems([document.segment_label(g) for g in range(len(structure.segments))])
+            self.segment.addItems([segment.summary for segment in structure.segments])
             self.kind.setCurrentIndex(self.kind.findData(document.kind))
             self.model_number.setRange(1, structure.n_models)
             self.model_number.setSuffix(f" of {structure.n_models}")

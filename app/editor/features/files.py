@@ -135,7 +135,7 @@ class Files:
         path, source, model, number = document.path, document.source, document.model_number, items.index(item) + 1
         try:
             with self.opening(assembly_path(path, number)):  # a capsid takes seconds
-                document.open_assembly(path, number, document.kind, model=model, data=source)
+                document.open(path, document.kind, data=source, model=model, assembly=number)
         except StructureError as error:
             QMessageBox.critical(self.window, PROG, str(error))
             return False

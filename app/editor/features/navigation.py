@@ -49,7 +49,7 @@ class Navigation:
     def select(self, rows: np.ndarray | list[int]) -> None:
         """Select residues ``rows``; where they lie in one segment, that segment becomes the
         edited one (framed: centre afterwards)."""
-        segments = {self.document.segment_of(int(row)) for row in rows}
+        segments = set(self.document.structure.residue_place(rows)[0].tolist())
         if len(segments) == 1:
             self.document.set_segment(segments.pop())
         self.document.select(rows)

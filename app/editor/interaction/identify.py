@@ -81,8 +81,8 @@ def describe(document: Document, hit: Hit) -> str:
         k = hit.index
         drawn = " · nucleic acid: drawn, not edited (no curve)" if table.category[k] == "nucleic" else ""
         return f"{table.chain[k]}:{table.resname[k]}{table.resseq[k]} {table.name[k]} ({table.element[k]}){drawn}"
-    segment = structure.segments[document.segment_of(hit.row)]
-    name = document.row_label(hit.row) + (f" {structure.atoms.name[hit.index]}" if hit.kind == "atom" else "")
+    segment = structure.segments[int(structure.residue_place(hit.row)[0])]
+    name = structure.residue_label(hit.row) + (f" {structure.atoms.name[hit.index]}" if hit.kind == "atom" else "")
     return f"{name} · {SS_NAMES[segment.ss[hit.row - int(segment.residue_index[0])]]}"
 
 

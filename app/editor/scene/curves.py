@@ -33,6 +33,13 @@ def rings_per_residue(n_residues: int) -> int:
     return RINGS_PER_RESIDUE if n_residues <= LARGE_RESIDUES else LARGE_RINGS_PER_RESIDUE
 
 
+def segment_paths(ribbons: list[Ribbon]) -> list[SegmentPath]:
+    """The sampling of every segment of a structure with these ``ribbons``, as many rings a
+    residue as its size allows (:func:`rings_per_residue`)."""
+    rings = rings_per_residue(sum(len(ribbon.residue_u) for ribbon in ribbons))
+    return [SegmentPath(ribbon, rings) for ribbon in ribbons]
+
+
 @dataclass(frozen=True, eq=False)
 class LevelCurve:
     """The curve of one segment at a slider level.

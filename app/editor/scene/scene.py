@@ -383,7 +383,7 @@ class Scene(QObject):
     def _update_caption(self) -> None:
         document = self.document
         text = document.read_only_reason or (
-            f"{document.structure.entry_id}   {document.segment_label(document.segment)}\n"
+            f"{document.structure.entry_id}   {document.structure.segments[document.segment].summary}\n"
             f"level {document.shown_level():.2f} of {document.max_level:.2f}   "
             f"{document.level_curve().n_segments} curve segments")
         if "caption" not in self.actors:  # a text actor of one font size (a corner annotation fits its

@@ -113,7 +113,7 @@ def test_ribbon_kind_changes_only_without_edits(ubiquitin: Document) -> None:
 def test_a_file_opens_on_its_longest_segment(qapp: QApplication) -> None:
     document = Document()
     document.open(DATA / "1ACB.pdb.gz")  # chymotrypsin's 13-residue chain first, then 131, 97 and 63
-    assert document.segment == 1 and document.segment_label(1).endswith("(131 residues)")
+    assert document.segment == 1 and document.structure.segments[1].summary.endswith("(131 residues)")
     assert document.level == round(np.log2(131) - 2)
     document.open(DATA / "4YVS.cif.gz")  # 226, 176, 48, 231, ...: the first of the longest
     assert document.segment == 3 and len(document.labels()) == 231
@@ -131,7 +131,7 @@ def test_segments_of_a_multichain_entry(qapp: QApplication) -> None:
     document.set_level(2.0)  # a coarse level of the short chain: as far below the long one's top
     document.set_segment(0)
     assert document.level == pytest.approx(np.log2(226) - (np.log2(48) - 2.0))
-    assert document.segment_label(2) == "B  THR190–GLN237 (48 residues)"
+    assert document.structure.segments[2].summary == "B  THR190–GLN237 (48 residues)"
     with pytest.raises(ValueError, match="segment must be in"):
         document.set_segment(20)
 

@@ -98,7 +98,7 @@ def test_hovering_names_the_residue_the_point_and_the_atom(window: MainWindow, q
     window.plotter.camera.zoom(4.0)
     window.plotter.render()
     _move(window, _display(window, document.model.coords[nz]))
-    assert window.status.labels["hover"].text().split(" · ")[0] == f"{document.row_label(table.residue[nz])} NZ"
+    assert window.status.labels["hover"].text().split(" · ")[0] == f"{document.structure.residue_label(table.residue[nz])} NZ"
 
     _move(window, (2, 2))  # the corner: nothing
     assert window.status.labels["hover"].text() == ""
@@ -145,7 +145,7 @@ def test_go_to_another_chain_makes_it_the_edited_segment(open_window: Opener) ->
     rows = window.navigation.go_to("C:87")
     document = window.document
     assert document.structure.segments[document.segment].chain == "C"
-    assert document.row_label(int(rows[0])) == "C:HIS87"
+    assert document.structure.residue_label(int(rows[0])) == "C:HIS87"
     np.testing.assert_allclose(_focal(window), _ca(window, int(rows[0])), atol=1e-6)
 
 

@@ -613,15 +613,20 @@ def test_choosing_another_chain_frames_it(qtbot: QtBot) -> None:
     assert np.ptp(pixels[:, 0]) > width / 4 or np.ptp(pixels[:, 1]) > height / 4  # framed, not a speck
 
 
-def test_the_window_fits_a_small_screen_and_keeps_its_layout(qtbot: QtBot, monkeypatch: pytest.MonkeyPatch) -> None:
-    """On a 1366 x 768 laptop the window fits; its size and docks come back at the next start (#17)."""
+def _laptop_screen(monkeypatch: pytest.MonkeyPatch, height: int) -> None:
+    """The primary screen as a laptop's: 1366 pixels wide, ``height`` available."""
     from PySide6.QtCore import QRect
 
     class Laptop:
         def availableGeometry(self) -> QRect:  # noqa: N802 (Qt's name)
-            return QRect(0, 0, 1366, 728)
+            return QRect(0, 0, 1366, height)
 
     monkeypatch.setattr(QApplication, "primaryScreen", staticmethod(lambda: Laptop()))
+
+
+def test_the_window_fits_a_small_screen_and_keeps_its_layout(qtbot: QtBot, monkeypatch: pytest.MonkeyPatch) -> None:
+    """On a 1366 x 768 laptop the window fits; its size and docks come back at the next start (#17)."""
+    _laptop_screen(monkeypatch, 728)  # (less a panel)
     window = MainWindow()
     qtbot.addWidget(window)
     assert window.width() <= 1366 and window.height() <= 728 - 32  # room for a title bar
@@ -640,11 +645,7 @@ def test_the_window_frame_fits_the_screen(qtbot: QtBot, monkeypatch: pytest.Monk
     status bar of a 1366 x 768 screen is not pushed off its bottom (#35)."""
     from PySide6.QtCore import QRect
 
-    class Laptop:
-        def availableGeometry(self) -> QRect:  # noqa: N802 (Qt's name)
-            return QRect(0, 0, 1366, 768)
-
-    monkeypatch.setattr(QApplication, "primaryScreen", staticmethod(lambda: Laptop()))
+    _laptop_screen(monkeypatch, 768)
     window = MainWindow()
     qtbot.addWidget(window)
     window.resize(1366, 768)

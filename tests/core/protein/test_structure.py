@@ -645,3 +645,15 @@ def test_a_file_without_element_columns_is_converted_with_the_elements_read(tmp_
     assert np.array_equal(written.atoms.element, structure.atoms.element)
     pdb = write_structure(structure, structure.coords, tmp_path / "adk.pdb")
     assert pdb.read_bytes() == gzip.decompress((DATA / "1AKE_adk_closed.pdb.gz").read_bytes())
+
+
+def test_residue_rows_are_placed_in_their_segments_and_named() -> None:
+    """Every row of the residue table lies in the segment whose residue_index holds it."""
+    structure = read_structure(DATA / "4YVS.cif.gz")
+    rows = np.arange(structure.n_residues)
+    segment, index = structure.residue_place(rows)
+    for k, s in enumerate(structure.segments):
+        assert np.array_equal(segment[s.residue_index], np.full(len(s), k))
+        assert np.array_equal(index[s.residue_index], np.arange(len(s)))
+    assert structure.residue_label(int(structure.segments[2].residue_index[0])) == "B:THR190"
+    assert structure.segments[2].summary == "B  THR190–GLN237 (48 residues)"
