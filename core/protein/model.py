@@ -144,6 +144,22 @@ class EditableModel:
         self.coords[edit.rows] = edit.new_coords
         self.ribbons[edit.segment] = self.ribbons[edit.segment].with_points(edit.new_points)
 
+    def check(self, edit: Edit) -> None:
+        """Raise ValueError unless ``edit`` was made on the model as it is now: its segment,
+        residues and rows exist, and the control points and coordinates it starts from are
+        these, bit for bit (an edit read from a file is checked before it is applied)."""
+        if not 0 <= edit.segment < len(self.ribbons):
+            raise ValueError(f"the structure has no segment {edit.segment + 1}")
+        points = self.ribbons[edit.segment].points
+        if edit.old_points.shape != points.shape:
+            raise ValueError(f"segment {edit.segment + 1} has {len(points)} control points, not {len(edit.old_points)}")
+        if len(edit.residues) and edit.residues.max() >= len(self.segments[edit.segment].ca):
+            raise ValueError(f"segment {edit.segment + 1} has no residue {edit.residues.max() + 1}")
+        if len(edit.rows) and edit.rows.max() >= len(self.coords):
+            raise ValueError(f"the structure has no atom {edit.rows.max() + 1}")
+        if not (np.array_equal(edit.old_points, points) and np.array_equal(edit.old_coords, self.coords[edit.rows])):
+            raise ValueError("it was not made on these coordinates")
+
     def revert(self, edit: Edit) -> None:
         """Undo ``edit`` exactly."""
         self.coords[edit.rows] = edit.old_coords

@@ -184,7 +184,7 @@ def read_bytes(path: str | os.PathLike[str]) -> bytes:
         raise StructureError(f"{path}: not a regular file (a device, FIFO or socket is not read)")
     if info.st_size > input_limit():
         raise StructureError(f"{path}: {info.st_size / 2**20:.0f} MiB is more than the input limit "
-                             f"({_limit_text()})")
+                             f"({limit_text()})")
     try:
         return path.read_bytes()
     except OSError as exc:
@@ -201,7 +201,8 @@ def input_limit() -> int:
                              f"{os.environ[LIMIT_VARIABLE]!r}") from None
 
 
-def _limit_text() -> str:
+def limit_text() -> str:
+    """The input limit and how to raise it, for messages."""
     return f"{input_limit() / 2**20:g} MiB; set ${LIMIT_VARIABLE} to raise it"
 
 
@@ -216,7 +217,7 @@ def _text(path: Path, data: bytes) -> tuple[str, str]:
                 while chunk := stream.read(GUNZIP_CHUNK):  # (read(limit) would allocate the whole limit)
                     size += len(chunk)
                     if size > limit:  # never more than the limit in memory
-                        raise StructureError(f"{path}: decompresses to more than the input limit ({_limit_text()})")
+                        raise StructureError(f"{path}: decompresses to more than the input limit ({limit_text()})")
                     chunks.append(chunk)
         except (OSError, EOFError, zlib.error) as exc:
             raise StructureError(f"{path}: corrupt gzip file ({exc})") from None

@@ -30,6 +30,7 @@ from typing import BinaryIO
 import gemmi
 import numpy as np
 
+from core.protein.reading import GUNZIP_CHUNK, input_limit, limit_text
 from core.surfaces.map_coefficients import is_mtz, read_mtz
 from core.surfaces.volume import DensityMap, MapError
 
@@ -88,6 +89,8 @@ def _read(file: BinaryIO) -> DensityMap:
         raise MapError(f"mode {mode} is not a mode of density values (0, 1, 2, 6 or 12)")
     if np.any(size_crs <= 0):
         raise MapError(f"its grid size {' × '.join(map(str, size_crs))} is not a size")
+    if np.any(size_crs < 2):
+        raise MapError(f"its grid {' × '.join(map(str, size_crs))} is not a volume (2 voxels or more along each axis)")
     if np.prod(size_crs, dtype=np.int64) > MAX_VOXELS:
         raise MapError(f"a grid of {' × '.join(map(str, size_crs))} voxels is larger than the {MAX_VOXELS:,} read")
     if extended < 0:
@@ -95,8 +98,11 @@ def _read(file: BinaryIO) -> DensityMap:
     unsigned = mode == 0 and words[38] == IMOD_STAMP and not words[39] & 1
     dtype = np.dtype(np.uint8 if unsigned else MODES[mode]).newbyteorder(order)
     count = int(np.prod(size_crs))
-    records = file.read(extended)
-    data = file.read(count * dtype.itemsize)
+    if count * (dtype.itemsize + 4) > input_limit():  # the values as stored, and as float32
+        raise MapError(f"a grid of {' × '.join(map(str, size_crs))} voxels needs "
+                       f"{count * (dtype.itemsize + 4) / 2**20:,.0f} MiB, more than the input limit ({limit_text()})")
+    records = _read_at_most(file, extended)
+    data = _read_at_most(file, count * dtype.itemsize)
     if len(data) < count * dtype.itemsize and len(records) + len(data) == count * dtype.itemsize:
         data = records + data  # symmetry records counted in the header but not in the file
     if len(data) < count * dtype.itemsize:
@@ -111,10 +117,14 @@ def _read(file: BinaryIO) -> DensityMap:
     if not finite.any():
         raise MapError("the map holds no finite values")
     if not finite.all():
-        values[~finite] = values[finite].mean()
+        values[~finite] = values[finite].mean(dtype=np.float64)
+    if values.min() == values.max():
+        raise MapError(f"the map holds one value everywhere ({values.min():g}): nothing to contour or fit")
 
     cell, sampling = _cell(cell, sampling, values.shape)
     axes = (np.array(gemmi.UnitCell(*cell).orth.mat.tolist()) / sampling).T  # rows: the steps along x, y, z
+    if not (np.isfinite(axes).all() and abs(np.linalg.det(axes)) > 1e-3 * np.prod(np.linalg.norm(axes, axis=1))):
+        raise MapError(f"its cell angles {', '.join(f'{a:g}' for a in cell[3:])}° make no cell (they enclose no volume)")
     corner = origin if _placed_by(origin, axes) else start @ axes if _placed_by_start(start, values.shape, sampling) \
         else np.zeros(3)
     resolution = _resolution(header, words)
@@ -122,6 +132,16 @@ def _read(file: BinaryIO) -> DensityMap:
         whole = _unit_cell(values, start, sampling.astype(int), gemmi.UnitCell(*cell), spacegroup)
         return DensityMap(whole, corner - start @ axes, axes, periodic=True, resolution=resolution)
     return DensityMap(values, corner, axes, resolution=resolution)
+
+
+def _read_at_most(file: BinaryIO, size: int) -> bytes:
+    """Up to ``size`` bytes of ``file``, read in pieces: a header that claims more than a
+    (gzipped) file holds never allocates what it claims."""
+    chunks, left = [], size
+    while left > 0 and (chunk := file.read(min(left, GUNZIP_CHUNK))):
+        chunks.append(chunk)
+        left -= len(chunk)
+    return b"".join(chunks)
 
 
 def _placed_by(origin: np.ndarray, axes: np.ndarray) -> bool:
@@ -174,8 +194,12 @@ def _unit_cell(values: np.ndarray, start: np.ndarray, sampling: np.ndarray, cell
     """The whole unit cell (sampling) of a box of a periodic map that starts at ``start``:
     the box wrapped into the cell, the rest filled from its symmetry mates in
     ``spacegroup`` (gemmi), where none reaches with the box's mean."""
-    if np.prod(sampling, dtype=np.int64) > MAX_VOXELS:
-        raise MapError(f"a unit cell of {' × '.join(map(str, sampling))} voxels is larger than the {MAX_VOXELS:,} read")
+    if np.any(sampling < 2):
+        raise MapError(f"its cell's sampling {' × '.join(map(str, sampling))} is not a grid (2 or more along each axis)")
+    voxels = int(np.prod(sampling, dtype=np.int64))
+    if voxels > MAX_VOXELS or voxels * 8 > input_limit():  # the cell, and gemmi's copy to symmetrize
+        raise MapError(f"a unit cell of {' × '.join(map(str, sampling))} voxels is larger than is read "
+                       f"({MAX_VOXELS:,} voxels and the input limit, {limit_text()})")
     whole = np.full(sampling, -np.inf, dtype=np.float32)
     index = np.ix_(*[(s + np.arange(n)) % m for s, n, m in zip(start, values.shape, sampling)])
     whole[index] = values
@@ -187,7 +211,7 @@ def _unit_cell(values: np.ndarray, start: np.ndarray, sampling: np.ndarray, cell
             whole = np.array(grid.array, dtype=np.float32)
         except RuntimeError:  # a sampling the symmetry cannot map onto itself: the box alone
             pass
-    whole[np.isneginf(whole)] = values.mean()
+    whole[np.isneginf(whole)] = values.mean(dtype=np.float64)
     return whole
 
 

@@ -83,7 +83,7 @@ class DensityMap:
     @cached_property
     def moments(self) -> tuple[float, float]:
         """The map's mean and rms deviation (σ)."""
-        return float(self.values.mean()), float(self.values.std())
+        return float(self.values.mean(dtype=np.float64)), float(self.values.std(dtype=np.float64))
 
     def sigma_level(self, contour: float) -> float:
         """The value ``mean + contour · rms deviation`` of the map."""

@@ -51,6 +51,14 @@ def questions(monkeypatch: pytest.MonkeyPatch) -> Questions:
     return recorder
 
 
+@pytest.fixture(autouse=True)
+def warned(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """No warning may block a test: the messages of ``QMessageBox.warning`` are recorded instead."""
+    shown: list[str] = []
+    monkeypatch.setattr(QMessageBox, "warning", lambda parent, title, text, *args: shown.append(text))
+    return shown
+
+
 @pytest.fixture
 def errors(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     """Messages of ``QMessageBox.critical`` dialogs, which are not shown."""

@@ -9,6 +9,7 @@ restored document is journalled anew; compared structures are dropped first.
 from __future__ import annotations
 
 import errno
+import sys
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -21,6 +22,7 @@ from app.editor.measurements import checked
 from app.editor.persistence import journal, records, session
 from app.editor.persistence.recording import recording, replay
 from app.editor.scene.molecule import Colouring
+from app.errors import printable
 from core.protein.structure import StructureError
 
 if TYPE_CHECKING:
@@ -60,20 +62,27 @@ class Sessions:
 
     def open_session(self, path: Path, *, raise_errors: bool = False) -> bool:
         """Open a session file after asking about unsaved edits: the structure, the undo history at
-        its position, the view and the compared structures (a bad file is reported in a dialog,
-        or raised as SessionError with ``raise_errors``)."""
+        its position, the view and the compared structures, as far as the file is valid (what was
+        left out is named in a warning, or on standard error when unattended). A file that cannot
+        be opened at all is reported in a dialog, or raised as SessionError with ``raise_errors``."""
         if not self.files.maybe_save():
             return False
         try:
-            recorded, view = session.read(Path(path))
-            self._replay(recorded)
-        except (session.SessionError, StructureError) as error:
+            contents = session.read(Path(path))
+            try:
+                left_out = contents.left_out + self._replay(contents.recording)
+            except StructureError as error:
+                raise session.SessionError(f"{path}: its structure cannot be read ({error})") from None
+        except session.SessionError as error:
             if raise_errors:
-                raise session.SessionError(str(error)) from None
+                raise
             QMessageBox.critical(self.window, PROG, str(error))
             return False
-        self._apply_view(view)
+        if contents.view is not None:
+            left_out += self._apply_view(contents.view)
         self.files.add_recent(Path(path))
+        if left_out:
+            self._warn(f"{Path(path).name} was opened as far as it is valid; left out: {left_out_text(left_out)}")
         return True
 
     def write_session(self, path: Path, *, overwrite: bool = False) -> Path:
@@ -109,14 +118,22 @@ class Sessions:
         return True
 
     def restore_journal(self, path: Path) -> str:
-        """Restore the document a crashed editor journalled at ``path``; returns what was
-        restored (raises OSError, RecordError or StructureError)."""
-        recorded, damaged = records.read(Path(path))
-        self._replay(recorded)
-        Path(path).unlink(missing_ok=True)
+        """Restore the document a crashed editor journalled at ``path`` as far as the journal is
+        valid; returns what was restored (raises OSError, RecordError or StructureError). The
+        journal is deleted, or set aside (``.unreadable``) where anything in it was left out."""
+        reading = records.read(Path(path))
+        if not reading.records:
+            raise records.RecordError("it is cut off inside its header: it holds no step")
+        left_out = reading.skipped + self._replay(reading.records)
         stack = self.document.undo_stack
         message = f"restored {stack.count()} undo step(s) of {self.document.path.name}, {stack.index()} done"
-        if damaged:
+        if left_out:
+            kept = Path(path).with_name(Path(path).name + journal.SET_ASIDE)
+            Path(path).rename(kept)
+            message += f"; left out: {left_out_text(left_out)} (the journal is kept as {kept})"
+        else:
+            Path(path).unlink(missing_ok=True)
+        if reading.cut_off:
             message += "; the journal was cut off after them (the step in progress at the crash is lost)"
         self.window.statusBar().showMessage(message, 15000)
         return message
@@ -149,13 +166,22 @@ class Sessions:
         if name:
             self.open_session(Path(name))
 
-    def _replay(self, recorded: list[records.Record]) -> None:
-        """The document as ``recorded`` says, journalled anew; compared structures are dropped."""
+    def _replay(self, recorded: list[records.Record]) -> list[str]:
+        """The document as ``recorded`` says, journalled anew; compared structures are dropped.
+        Returns the steps left out (:func:`~app.editor.persistence.recording.replay`)."""
         self.journal.discard()
         while self.comparison.items:
             self.comparison.remove(0)
-        replay(self.document, recorded)
+        left_out = replay(self.document, recorded)
         self.journal.write_all()
+        return left_out
+
+    def _warn(self, message: str) -> None:
+        """``message`` in a warning, or on standard error when nobody watches (a script)."""
+        if self.files.unattended:
+            print(f"{PROG}: {printable(message)}", file=sys.stderr)
+        else:
+            QMessageBox.warning(self.window, PROG, message)
 
     def _view(self) -> session.View:
         compared = [session.ComparedFile(item.path, item.source, item.chain, item.visible)
@@ -166,7 +192,8 @@ class Sessions:
                             [m.record() for m in self.document.measurements.items],
                             None if self.scene.slab is None else list(self.scene.slab))
 
-    def _apply_view(self, view: session.View) -> None:
+    def _apply_view(self, view: session.View) -> list[str]:
+        """Show ``view``; returns the measurements and compared structures left out, and why."""
         for layer, box in self.display_panel.layer_boxes.items():
             box.setChecked(layer.name in view.layers)
         panel = self.display_panel
@@ -174,33 +201,40 @@ class Sessions:
         panel.fat.setChecked(view.fat_helices)
         panel.cylinders.setChecked(view.helix_cylinders)
         self.clipping.set(None if view.slab is None else (view.slab[0], view.slab[1]))
-        measured = []
+        measured, left_out = [], []
         for kept in view.measurements:
             try:
                 measured.append(checked(kept.get("atoms"), len(self.document.model.coords), bool(kept.get("residue"))))
             except (AttributeError, TypeError, ValueError) as error:  # a session written by hand, or damaged
-                self.window.statusBar().showMessage(f"a measurement of the session left out: {error}", 15000)
+                left_out.append(f"a measurement ({error})")
         self.document.measurements.replace(measured)  # drawn and listed once
         for item in view.compared:
             try:
                 self.comparison.add(item.path, item.chain, item.source)
             except (StructureError, ValueError) as error:
-                self.window.statusBar().showMessage(f"compared structure {item.path.name} left out: {error}", 15000)
+                left_out.append(f"compared structure {item.path.name} ({error})")
                 continue
             self.comparison.set_visible(len(self.comparison.items) - 1, item.visible)
         self.plotter.camera_position = [tuple(vector) for vector in view.camera]
         self.plotter.render()
+        return left_out
 
 
 def journal_subject(path: Path) -> str:
     """The name of the file whose edits the journal at ``path`` holds ('the edits' if unreadable)."""
     try:
-        entries, _ = records.read(path)
-        return Path(entries[0].fields["path"]).name if entries and entries[0].kind == "header" else "a structure"
-    except (OSError, records.RecordError, KeyError, TypeError):
+        entries = records.read(path).records
+    except (OSError, records.RecordError):
         return "a structure"
+    return Path(entries[0].fields["path"]).name if entries else "a structure"
 
 
 def time_label(path: Path) -> str:
     """When the journal at ``path`` was last written, for people."""
     return "last edit " + time.strftime("%Y-%m-%d %H:%M", time.localtime(path.stat().st_mtime))
+
+
+def left_out_text(left_out: list[str], shown: int = 5) -> str:
+    """What was left out of a file, for people: the first ``shown`` things and how many more."""
+    more = len(left_out) - shown
+    return "; ".join(left_out[:shown]) + (f"; and {more} more" if more > 0 else "")

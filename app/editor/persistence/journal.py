@@ -194,7 +194,7 @@ def sweep(folder: Path | None = None) -> tuple[list[Path], list[Path]]:
     found, aside = [], []
     for path in folder.glob(f"*{SUFFIX}"):
         try:
-            fd = os.open(path, os.O_RDONLY)
+            fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)  # (a FIFO never blocks the start)
         except OSError:
             continue
         try:
@@ -204,7 +204,8 @@ def sweep(folder: Path | None = None) -> tuple[list[Path], list[Path]]:
         finally:
             os.close(fd)
         try:
-            recording, damaged = records.read(path)
+            reading = records.read(path)
+            recording, damaged = reading.records, reading.damaged
         except OSError:
             continue  # (unreadable now: left for the next sweep)
         except records.RecordError:

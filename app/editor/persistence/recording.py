@@ -30,36 +30,73 @@ def recording(document: Document) -> list[records.Record]:
             records.Record("index", state(document))]
 
 
-def replay(document: Document, recording: list[records.Record]) -> None:
+def replay(document: Document, recording: list[records.Record]) -> list[str]:
     """Make ``document`` what ``recording`` (:func:`recording`, or a journal) describes: the
     file as read (the same model), the same undo history at the same position, bit for bit.
-    Views are told once, at the end. Raises StructureError for an unreadable embedded file."""
-    head, files, view = recording[0].fields, None, None
+    Each step is checked before it is pushed (:meth:`~core.protein.model.EditableModel.check`):
+    one that was not made on the document as replayed so far (a step before it lost, another
+    structure) is left out, and so is every step built on it. Views are told once, at the end.
+    Returns what was left out, for people; raises StructureError for an unreadable embedded file."""
+    head, files, view, left_out = recording[0].fields, None, None, []
     with document.rebuilding():
         document.open(Path(head["path"]), head["kind"], records.source_of(recording[0]), records.model_of(head))
         stack = document.undo_stack
         for record in recording[1:]:
             if record.kind == "push":
-                stack.setIndex(record.fields["at"])
-                stack.push(EditCommand(document, records.edits_of(record), record.fields["text"]))
+                reason = _unfit(document, record)
+                if reason is None:
+                    stack.push(EditCommand(document, records.edits_of(record), record.fields["text"]))
+                else:
+                    left_out.append(f"step {record.fields['at'] + 1} ({record.fields['text'][:60]}): {reason}")
             elif record.kind == "index":
-                stack.setIndex(record.fields["index"])
+                stack.setIndex(min(record.fields["index"], stack.count()))
                 files = view = record.fields
             elif record.kind == "state":
                 view = record.fields
         if files is not None:
+            left_out += _past_the_steps(files, stack.count())
             _restore_files(document, files)
         if view is not None:
             document.segment = max(0, min(int(view["segment"]), len(document.model.ribbons) - 1))
             document.multiresolution = bool(view["multiresolution"])
             document.level = float(np.clip(view["level"], 0.0, document.max_level))
+    return left_out
+
+
+def _unfit(document: Document, record: records.Record) -> str | None:
+    """Why the step of ``record`` cannot be pushed where it was (None: the stack is left at
+    that position, the document as the step found it)."""
+    stack, at = document.undo_stack, record.fields["at"]
+    if at > stack.count():
+        return "a step before it is missing"
+    index = stack.index()
+    stack.setIndex(at)
+    model, applied, reason = document.model, [], None
+    try:
+        for edit in records.edits_of(record):  # (each edit of a step starts where the one before ended)
+            model.check(edit)
+            model.apply(edit)
+            applied.append(edit)
+    except ValueError as error:
+        reason = str(error)
+    for edit in reversed(applied):
+        model.revert(edit)
+    if reason is not None:
+        stack.setIndex(index)
+    return reason
+
+
+def _past_the_steps(state: dict, count: int) -> list[str]:
+    """What of the last ``index`` record's positions lies past the ``count`` steps restored."""
+    return [f"the {what} position {state[name]} is past the {count} steps restored" for name, what in
+            (("index", "current"), ("clean", "saved")) if state[name] > count]
 
 
 def _restore_files(document: Document, state: dict) -> None:
     """The clean position and the structure's file name of an ``index`` record."""
     stack = document.undo_stack
     index = stack.index()
-    if state["clean"] >= 0:
+    if 0 <= state["clean"] <= stack.count():
         stack.setIndex(state["clean"])
         stack.setClean()
     else:

@@ -4,9 +4,10 @@
 A file is :data:`MAGIC`, then records. A record is its payload length and CRC-32 (two
 little-endian uint32), then the payload: a line of JSON (``record``, the kind of record,
 its fields, and the names, dtypes and shapes of its arrays) followed by the arrays' raw
-bytes. Arrays are
-written as they are in memory, so coordinates come back bit for bit. A file cut off
-mid-record (a crash while writing) reads as the records before the damage.
+bytes. Arrays are written as they are in memory, so coordinates come back bit for bit. A
+file cut off mid-record (a crash while writing) reads as the records before the cut; damaged
+bytes in the middle are passed over to the next record whose CRC holds, and each record is
+checked against its kind's rules (:mod:`app.editor.persistence.schema`) before it is used.
 
 Kinds: ``header`` (format version, file name, ribbon kind, model, the file's bytes as read),
 ``push`` (an undo step pushed at a stack position: its text and the
@@ -19,6 +20,10 @@ alone) and ``view`` (session files: layers, camera, compared structures).
 from __future__ import annotations
 
 import json
+import math
+import os
+import re
+import stat
 import struct
 import zlib
 from collections.abc import Sequence
@@ -27,7 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
+from app.editor.persistence import schema
 from core.protein.model import Edit
+from core.protein.reading import input_limit, limit_text
 
 MAGIC = b"\x89RWAVE\r\n"
 """The first bytes of a journal or session file."""
@@ -36,7 +43,6 @@ VERSION = 3
 added the model of the header (version 1 files hold model 1), version 3 steps of several
 segments (a push record of one segment is written as before)."""
 _FRAME = struct.Struct("<II")
-_EDIT_ARRAYS = ("old_points", "new_points", "residues", "rows", "old_coords", "new_coords")
 
 
 class RecordError(ValueError):
@@ -61,44 +67,118 @@ def encode(record: Record) -> bytes:
     return _FRAME.pack(len(payload), zlib.crc32(payload)) + payload
 
 
-def decode(data: bytes) -> tuple[list[Record], bool]:
-    """The records of a file's bytes and whether it was damaged (cut off or corrupt after
-    the last record returned). Raises RecordError for a file that is not one of ours."""
+@dataclass(frozen=True)
+class Reading:
+    """What a file's bytes hold (:func:`decode`)."""
+
+    records: list[Record]
+    """The records that can be used, in file order."""
+    skipped: list[str] = field(default_factory=list)
+    """What was passed over, for people: damaged bytes, records that break their rules."""
+    cut_off: bool = False
+    """Whether the file ends inside a record (a crash while writing)."""
+
+    @property
+    def damaged(self) -> bool:
+        """Whether anything was passed over or cut off."""
+        return bool(self.skipped) or self.cut_off
+
+
+def decode(data: bytes) -> Reading:
+    """The records of a file's bytes. Damaged bytes are passed over to the next record whose
+    CRC holds, and a record that breaks its rules (:mod:`~app.editor.persistence.schema`) is
+    left out; both are named in :attr:`Reading.skipped`. Raises RecordError for a file that is
+    not one of ours, of a newer version, or whose header is damaged."""
     if not data.startswith(MAGIC):
         raise RecordError("not a ribbonwave journal or session file")
-    records, offset, damaged = [], len(MAGIC), False
-    while offset < len(data) and not damaged:
-        record, offset = _record_at(data, offset)
-        damaged = record is None
-        records += [] if damaged else [record]
-    if records and records[0].kind == "header" and records[0].fields.get("version", 0) > VERSION:
-        raise RecordError(f"written by a newer ribbonwave (format {records[0].fields['version']}; "
-                          f"this one reads format {VERSION})")
-    if (records[0].kind != "header") if records else not damaged:  # (cut inside the header: nothing to read)
-        raise RecordError("no header record: not a ribbonwave journal or session file")
-    return records, damaged
+    found, skipped, offset, cut_off = [], [], len(MAGIC), False
+    while offset < len(data):
+        end, record, wrong = _record_at(data, offset)
+        if end is None:
+            end = _next_frame(data, offset + 1)
+            if end is None:
+                cut_off = True
+                break
+            skipped.append(f"{end - offset} damaged bytes at byte {offset}")
+        elif wrong is None:
+            found.append(record)
+        else:
+            if not found and record is not None and record.kind == "header":
+                _refuse_newer(record.fields)
+            skipped.append(wrong)
+        offset = end
+    if found and found[0].kind == "header":
+        _refuse_newer(found[0].fields)
+    if not found and cut_off and not skipped:
+        return Reading([], [], True)  # (cut inside the header: nothing was written yet)
+    if not found or found[0].kind != "header":
+        reason = skipped[0] if skipped else "no header record"
+        raise RecordError(f"its header is damaged or missing ({reason}): not readable as a ribbonwave journal "
+                          "or session file")
+    return Reading(found, skipped, cut_off)
 
 
-def _record_at(data: bytes, offset: int) -> tuple[Record | None, int]:
-    """The record framed at ``offset`` and the offset after it; None if it is incomplete or corrupt."""
+def _refuse_newer(fields: dict) -> None:
+    version = fields.get("version")
+    if type(version) is int and version > VERSION:
+        raise RecordError(f"written by a newer ribbonwave (format {version}; this one reads format {VERSION})")
+
+
+def _record_at(data: bytes, offset: int) -> tuple[int | None, Record | None, str | None]:
+    """The end of the record framed at ``offset`` (None if it is incomplete or its CRC fails),
+    the record, and why it cannot be used (None if it can)."""
     if offset + _FRAME.size > len(data):
-        return None, offset
+        return None, None, None
     length, crc = _FRAME.unpack_from(data, offset)
-    payload = data[offset + _FRAME.size : offset + _FRAME.size + length]
+    end = offset + _FRAME.size + length
+    payload = data[offset + _FRAME.size : end]
     if len(payload) != length or zlib.crc32(payload) != crc:
-        return None, offset
+        return None, None, None
     line, _, raw = payload.partition(b"\n")
     try:
         meta = json.loads(line)
-        arrays, start = {}, 0
-        for name, dtype, shape in meta.pop("arrays"):
-            array = np.frombuffer(raw, dtype=np.dtype(dtype), count=int(np.prod(shape)), offset=start).reshape(shape)
-            arrays[name] = array.copy()
-            start += array.nbytes
-        kind = meta.pop("record")
-    except (ValueError, KeyError, TypeError):
-        return None, offset
-    return Record(kind, meta, arrays), offset + _FRAME.size + length
+    except (ValueError, RecursionError):
+        return end, None, "a record whose fields are not JSON"
+    if type(meta) is not dict or type(meta.get("record")) is not str:
+        return end, None, "a record of no kind"
+    kind = meta.pop("record")
+    arrays, wrong = _arrays(meta.pop("arrays", []), raw)
+    wrong = schema.problem(kind, meta, arrays) if wrong is None else f"{kind[:40]} record: {wrong}"
+    return end, Record(kind, meta, arrays), wrong
+
+
+_DTYPE = re.compile(r"[<>|=]?[fiub][1248]")
+
+
+def _arrays(names: object, raw: bytes) -> tuple[dict[str, np.ndarray], str | None]:
+    """The arrays a record's JSON line names (``[name, dtype, shape]`` each) in the bytes
+    ``raw`` after it, and why they cannot be read (None if they can)."""
+    arrays, start = {}, 0
+    if type(names) is not list:
+        return {}, "its 'arrays' is not a list"
+    for entry in names:
+        if not (type(entry) is list and len(entry) == 3 and type(entry[0]) is str and type(entry[1]) is str
+                and _DTYPE.fullmatch(entry[1]) and type(entry[2]) is list and len(entry[2]) <= 4
+                and all(type(n) is int and n >= 0 for n in entry[2])):
+            return {}, f"array entry {str(entry)[:40]} is not [name, dtype, shape]"
+        name, dtype, shape = entry[0], np.dtype(entry[1]), entry[2]
+        size = math.prod(shape) * dtype.itemsize
+        if start + size > len(raw):
+            return {}, f"array {name[:40]!r} runs past the record"
+        arrays[name] = np.frombuffer(raw, dtype=dtype, count=math.prod(shape), offset=start).reshape(shape).copy()
+        start += size
+    return arrays, None
+
+
+def _next_frame(data: bytes, start: int) -> int | None:
+    """The offset of the first record at or after ``start`` whose CRC holds (a record's
+    payload starts with its JSON object), or None."""
+    at = data.find(b'{"', start + _FRAME.size)
+    while at >= 0:
+        if _record_at(data, at - _FRAME.size)[0] is not None:
+            return at - _FRAME.size
+        at = data.find(b'{"', at + 1)
+    return None
 
 
 def header(path: Path, kind: str, source: bytes, model: int) -> Record:
@@ -117,18 +197,20 @@ def push(at: int, text: str, edits: Sequence[Edit]) -> Record:
     if len(edits) == 1:
         edit = edits[0]
         return Record("push", {"at": at, "text": text, "segment": edit.segment},
-                      {name: getattr(edit, name) for name in _EDIT_ARRAYS})
+                      {name: getattr(edit, name) for name in schema.EDIT_ARRAYS})
     return Record("push", {"at": at, "text": text, "segments": [edit.segment for edit in edits]},
-                  {f"{k}.{name}": getattr(edit, name) for k, edit in enumerate(edits) for name in _EDIT_ARRAYS})
+                  {f"{k}.{name}": getattr(edit, name) for k, edit in enumerate(edits) for name in schema.EDIT_ARRAYS})
 
 
 def edits_of(record: Record) -> list[Edit]:
-    """The edits of a ``push`` record."""
+    """The edits of a ``push`` record, their indices as int64 and coordinates as float64 (as
+    this machine holds them: a file's other integer or float types convert exactly)."""
     fields, arrays = record.fields, record.arrays
-    if "segments" not in fields:
-        return [Edit(fields["segment"], *(arrays[name] for name in _EDIT_ARRAYS))]
-    return [Edit(segment, *(arrays[f"{k}.{name}"] for name in _EDIT_ARRAYS))
-            for k, segment in enumerate(fields["segments"])]
+    prefixes = [f"{k}." for k in range(len(fields["segments"]))] if "segments" in fields else [""]
+    segments = fields["segments"] if "segments" in fields else [fields["segment"]]
+    return [Edit(segment, *(arrays[prefix + name].astype(np.int64 if name in ("residues", "rows") else np.float64)
+                            for name in schema.EDIT_ARRAYS))
+            for prefix, segment in zip(prefixes, segments, strict=True)]
 
 
 def source_of(record: Record) -> bytes:
@@ -136,7 +218,14 @@ def source_of(record: Record) -> bytes:
     return record.arrays["source"].tobytes()
 
 
-def read(path: Path) -> tuple[list[Record], bool]:
-    """The records of the file at ``path`` and whether it was damaged (see :func:`decode`);
-    raises OSError or RecordError."""
-    return decode(Path(path).read_bytes())
+def read(path: Path) -> Reading:
+    """The records of the file at ``path`` (see :func:`decode`); raises OSError, or RecordError
+    for anything but a regular file (a FIFO or device is never read) or one over the input limit."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    with os.fdopen(fd, "rb") as file:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise RecordError("not a regular file (a device, FIFO or socket is not read)")
+        if info.st_size > input_limit():
+            raise RecordError(f"{info.st_size / 2**20:.0f} MiB is more than the input limit ({limit_text()})")
+        return decode(file.read())

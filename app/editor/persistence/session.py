@@ -81,19 +81,34 @@ def write(path: Path, recording: list[records.Record], view: View) -> None:
     atomic_write(Path(path), records.MAGIC + b"".join(records.encode(r) for r in [*recording, view.record()]))
 
 
-def read(path: Path) -> tuple[list[records.Record], View]:
-    """The document's recording and the view of the session at ``path`` (raises SessionError)."""
+@dataclass(frozen=True)
+class Contents:
+    """What a session file holds, as far as it is valid (:func:`read`)."""
+
+    recording: list[records.Record]
+    """The document's recording (:func:`~app.editor.persistence.recording.replay`)."""
+    view: View | None
+    """What the window showed; None if its record was damaged or missing."""
+    left_out: list[str]
+    """What was passed over, for people (damaged bytes, records that break their rules)."""
+
+
+def read(path: Path) -> Contents:
+    """The session at ``path`` as far as it is valid (raises SessionError for a file that is not
+    a session, of a newer format, or whose structure cannot be read)."""
     path = Path(path)
     try:
-        recording, damaged = records.read(path)
+        reading = records.read(path)
     except OSError as error:
         raise SessionError(f"{path}: cannot read ({error.strerror})") from None
     except records.RecordError as error:
         raise SessionError(f"{path}: {error}") from None
-    views = [r for r in recording if r.kind == "view"]
-    if damaged or not views:
-        raise SessionError(f"{path}: the session file is damaged (incomplete)")
-    try:
-        return [r for r in recording if r.kind != "view"], View.of(views[-1])
-    except (KeyError, TypeError, ValueError) as error:
-        raise SessionError(f"{path}: the session file is damaged ({error})") from None
+    if not reading.records:
+        raise SessionError(f"{path}: the session file is damaged (cut off inside its structure)")
+    views = [r for r in reading.records if r.kind == "view"]
+    left_out = list(reading.skipped)
+    if reading.cut_off:
+        left_out.append("the file is cut off: what followed is lost")
+    if not views:
+        left_out.append("no view record: the window's view stays as it is")
+    return Contents([r for r in reading.records if r.kind != "view"], View.of(views[-1]) if views else None, left_out)

@@ -114,7 +114,7 @@ def test_a_recording_replays_the_same_model_and_older_ones_read_as_model_1(qapp:
     old = recorded(first)
     fields = {k: v for k, v in old[0].fields.items() if k != "model"} | {"version": 1}  # as version 1 wrote it
     old[0] = records.Record("header", fields, old[0].arrays)
-    decoded, _ = records.decode(records.MAGIC + b"".join(records.encode(r) for r in old))
+    decoded = records.decode(records.MAGIC + b"".join(records.encode(r) for r in old)).records
     replay(again, decoded)
     assert again.model_number == 1 and np.array_equal(again.model.coords, first.model.coords)
 
@@ -156,7 +156,7 @@ def test_a_session_restores_the_model(qtbot: QtBot, tmp_path: Path) -> None:
     window = _edited_window(qtbot, 4)
     history, coords = window.rw.history(), window.rw.coords()
     saved = window.sessions.write_session(tmp_path / "ensemble")
-    assert session.read(saved)[0][0].fields["model"] == 4
+    assert session.read(saved).recording[0].fields["model"] == 4
     window.document.undo_stack.setClean()  # no question on the way out
     assert window.files.open_file(DATA / "1UBQ.pdb.gz") and window.sessions.open_session(saved)
     assert window.rw.model == 4 and window.dimension_panel.model_number.value() == 4
@@ -171,7 +171,7 @@ def test_a_session_restores_the_model(qtbot: QtBot, tmp_path: Path) -> None:
 def test_crash_recovery_restores_the_model(qtbot: QtBot) -> None:
     crashed = _edited_window(qtbot, 17)
     history, coords, path = crashed.rw.history(), crashed.rw.coords(), crashed.journal.path
-    assert records.read(path)[0][0].fields["model"] == 17
+    assert records.read(path).records[0].fields["model"] == 17
     crashed.files.unattended = True
     crashed.close()  # as a crash leaves it: the journal stays
     window = _window(qtbot, DATA / "3PTB.pdb.gz")

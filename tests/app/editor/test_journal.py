@@ -16,6 +16,8 @@ from test_window import _drag_control_point, _window
 
 from app.editor.main_window import MainWindow
 from app.editor.persistence import journal, records
+from app.editor.persistence.schema import EDIT_ARRAYS
+from core.protein.model import Edit
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 ROOT = Path(__file__).resolve().parents[3]
@@ -26,9 +28,9 @@ def _edit(window: MainWindow, which: int, offset: tuple[int, int] = (30, 20)) ->
 
 
 def _journal_records(window: MainWindow) -> list[records.Record]:
-    recording, damaged = records.read(window.journal.path)
-    assert not damaged
-    return recording
+    reading = records.read(window.journal.path)
+    assert not reading.damaged
+    return reading.records
 
 
 # ---------------------------------------------------------------------------- the format
@@ -36,14 +38,21 @@ def _journal_records(window: MainWindow) -> list[records.Record]:
 
 def test_records_round_trip_bit_for_bit() -> None:
     rng = np.random.default_rng(3)
-    arrays = {"coords": rng.normal(size=(17, 3)), "rows": np.arange(17, dtype=np.int64) * 3, "empty": np.zeros((0, 3))}
-    record = records.Record("push", {"text": "Move point 3", "at": 2}, arrays)
-    (back,), damaged = records.decode(records.MAGIC + records.encode(records.header(Path("x.pdb"), "peptide", b"ab", 1))
-                                      + records.encode(record))[0][1:], False
-    assert back.kind == "push" and back.fields == record.fields and not damaged
-    for name, array in arrays.items():
-        assert back.arrays[name].dtype == array.dtype and np.array_equal(back.arrays[name], array)
-        assert back.arrays[name].tobytes() == array.tobytes()
+    rows = np.arange(17, dtype=np.int64) * 3
+    edit = Edit(2, rng.normal(size=(9, 3)), rng.normal(size=(9, 3)), np.arange(4), rows, rng.normal(size=(17, 3)),
+                rng.normal(size=(17, 3)))
+    empty = Edit(0, np.zeros((7, 3)), np.zeros((7, 3)), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                 np.zeros((0, 3)), np.zeros((0, 3)))
+    for edits in ([edit], [edit, empty]):
+        record = records.push(2, "Move point 3", edits)
+        reading = records.decode(records.MAGIC + records.encode(records.header(Path("x.pdb"), "peptide", b"ab", 1))
+                                 + records.encode(record))
+        (back,) = reading.records[1:]
+        assert back.kind == "push" and back.fields == record.fields and not reading.damaged
+        for name, array in record.arrays.items():
+            assert back.arrays[name].dtype == array.dtype and back.arrays[name].tobytes() == array.tobytes()
+        assert all(a.segment == b.segment and all(np.array_equal(getattr(a, n), getattr(b, n)) for n in EDIT_ARRAYS)
+                   for a, b in zip(records.edits_of(back), edits, strict=True))
 
 
 def test_a_journal_cut_anywhere_gives_the_records_before_the_cut(qtbot: QtBot) -> None:
@@ -51,17 +60,34 @@ def test_a_journal_cut_anywhere_gives_the_records_before_the_cut(qtbot: QtBot) -
     for k in range(3):
         _edit(window, k + 2)
     data = window.journal.path.read_bytes()
-    whole, damaged = records.decode(data)
-    assert not damaged and [r.kind for r in whole].count("push") == 3
+    whole = records.decode(data).records
+    assert [r.kind for r in whole].count("push") == 3
     ends = np.cumsum([len(records.MAGIC)] + [len(records.encode(r)) for r in whole])
     for cut in range(int(ends[0]) + 1, len(data), 97):  # every 97th byte: inside headers, JSON and arrays
-        got, damaged = records.decode(data[:cut])
+        reading = records.decode(data[:cut])
         complete = int(np.searchsorted(ends, cut, side="right")) - 1
-        assert damaged == (cut not in ends) and len(got) == complete
-    flipped = bytearray(data)
-    flipped[int(ends[2]) + 20] ^= 0xFF  # a corrupt byte inside the second push: the CRC catches it
-    got, damaged = records.decode(bytes(flipped))
-    assert damaged and len(got) == 2
+        assert reading.cut_off == (cut not in ends) and len(reading.records) == complete and not reading.skipped
+
+
+def test_damage_mid_journal_is_passed_over_to_the_next_record(qtbot: QtBot) -> None:
+    """One bad byte used to end the journal there: every later step was lost (#37, item 2). The
+    reader now resynchronises on the next record whose CRC holds, and names what it passed over."""
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    for k in range(4):
+        _edit(window, k + 2)
+    data = window.journal.path.read_bytes()
+    whole = records.decode(data).records
+    ends = np.cumsum([len(records.MAGIC)] + [len(records.encode(r)) for r in whole])
+    rng = np.random.default_rng(37)
+    for k in range(2, len(whole)):  # a flipped byte anywhere in each record after the header
+        flipped = bytearray(data)
+        flipped[rng.integers(ends[k - 1], ends[k])] ^= 1 << int(rng.integers(8))
+        reading = records.decode(bytes(flipped))
+        assert [r.kind for r in reading.records] == [r.kind for j, r in enumerate(whole) if j != k - 1]
+        assert len(reading.skipped) == 1 and "damaged bytes" in reading.skipped[0] and not reading.cut_off
+    cut = bytearray(data)
+    del cut[int(ends[3]) : int(ends[3]) + 50]  # bytes lost mid-file: the record they were part of is passed over
+    assert len(records.decode(bytes(cut)).records) == len(whole) - 1
 
 
 def test_not_a_journal_or_a_newer_one_is_refused() -> None:
@@ -273,7 +299,7 @@ def test_a_journal_that_cannot_be_read_is_set_aside_never_deleted(qtbot: QtBot, 
     crashed.close()
     data = bytearray(path.read_bytes())
     if damage == "newer format":
-        entries, _ = records.read(path)
+        entries = records.read(path).records
         entries[0].fields["version"] = records.VERSION + 1
         data = bytearray(records.MAGIC + b"".join(records.encode(entry) for entry in entries))
     else:

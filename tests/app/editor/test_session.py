@@ -101,7 +101,7 @@ def test_a_session_opens_when_the_structure_file_has_moved(qtbot: QtBot, tmp_pat
     assert np.array_equal(window.rw.coords(), coords) and window.document.path == original
 
 
-def test_bad_sessions_give_a_message(qtbot: QtBot, tmp_path: Path, errors: list[str],
+def test_bad_sessions_give_a_message(qtbot: QtBot, tmp_path: Path, errors: list[str], warned: list[str],
                                      capsys: pytest.CaptureFixture[str]) -> None:
     window = _window(qtbot, DATA / "1UBQ.pdb.gz")
     window.rw.move(5, [3.0, 0.0, 0.0])
@@ -110,7 +110,7 @@ def test_bad_sessions_give_a_message(qtbot: QtBot, tmp_path: Path, errors: list[
     newer = records.Record("header", {"version": records.VERSION + 1, "path": "x.pdb", "kind": "peptide"})
     cases = {
         "newer.rwsession": (records.MAGIC + records.encode(newer), "newer ribbonwave"),
-        "cut.rwsession": (data[: len(data) - 100], "damaged"),
+        "cut.rwsession": (data[:100], "damaged"),
         "text.rwsession": (b"HEADER    not a session\n", "not a ribbonwave"),
     }
     for name, (content, message) in cases.items():
@@ -121,6 +121,12 @@ def test_bad_sessions_give_a_message(qtbot: QtBot, tmp_path: Path, errors: list[
         assert main([str(tmp_path / name), "--screenshot", str(tmp_path / "x.png")]) == 1
         err = capsys.readouterr().err
         assert err.startswith("ribbonwave: error:") and message in err and "Traceback" not in err
+    (tmp_path / "cut.rwsession").write_bytes(data[: len(data) - 100])  # the view lost: the rest opens, and it says so
+    window.document.undo_stack.setClean()
+    assert window.sessions.open_session(tmp_path / "cut.rwsession") and window.rw.history()[1] == 1
+    assert "cut.rwsession was opened as far as it is valid; left out: the file is cut off" in warned[-1]
+    assert main([str(tmp_path / "cut.rwsession"), "--screenshot", str(tmp_path / "x.png")]) == 0
+    assert "left out: the file is cut off" in capsys.readouterr().err
 
 
 def test_saving_a_session_is_atomic(qtbot: QtBot, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
