@@ -9,7 +9,7 @@ import numpy as np
 
 from app.arguments import LEVEL, bounded
 from app.cli.curve import ribbon_argument
-from app.cli.structure import chain_segments, load, model_argument
+from app.cli.structure import chain_segments, checked_output, load, model_argument
 from app.errors import InputError
 from core.geometry.regularize import regularized
 from core.geometry.validation import validate
@@ -40,6 +40,7 @@ def edit_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_edit(args: argparse.Namespace) -> int:
+    checked_output(args.output, args.overwrite)
     structure = load(args.file, args.model)
     number = chain_segments(structure, args.chain, args.segment)[0]
     model = EditableModel(structure, RibbonKind(args.ribbon))

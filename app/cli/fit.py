@@ -6,13 +6,15 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from app.arguments import bounded
-from app.cli.structure import chain_segments, load, model_argument
+from app.cli.structure import chain_segments, checked_output, load, model_argument
 from app.errors import InputError
 from core.analysis.compare import PAIRINGS
 from core.analysis.superpose import superpose
@@ -89,6 +91,7 @@ def fit_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_fit(args: argparse.Namespace) -> int:
+    checked_output(args.output, args.overwrite)
     structure = load(args.file, args.model)
     model = EditableModel(structure)
     before = validate(structure, model.coords).counts
@@ -162,7 +165,8 @@ def _fit_structure(model: EditableModel, args: argparse.Namespace) -> Fitted:
         raise InputError("--resolution and --no-domains are for a map target; TARGET is a structure")
     target = load(args.to)
     pairs, pairing, rows = _paired(model, args.chain, target, args.target_chain, args.pairing)
-    result = _settled(lambda levels: fit_conformation(model, pairs, levels, regularize=args.regularize), args.levels)
+    result = _settled(lambda levels: fit_conformation(model, pairs, levels, regularize=args.regularize), model,
+                      args.levels)
     report = {"pairing": pairing, "pairs": len(rows), "what": f"{len(rows)} residue pairs ({pairing})"}
     return result, report, "rmsd", lambda: superpose(model.coords[rows], np.concatenate([p.target for p in pairs])).rmsd, \
         None
@@ -191,7 +195,7 @@ def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
         raise InputError(str(error)) from None
     first = [DOMAINS] if args.domains and args.levels[0] == 0 else []
     result = _settled(lambda levels: fit_map(model, segments, target, [*first, *levels], regularize=args.regularize),
-                      args.levels)
+                      model, args.levels)
     rows = heavy_atoms(model)
     report = {"resolution": round(resolution, 2), "resolution_from": source, "segments": len(segments),
               "what": f"{len(segments)} segment(s) into the map at {resolution:.3g} Å ({source}; each level into the "
@@ -202,7 +206,12 @@ def _fit_map(model: EditableModel, args: argparse.Namespace) -> Fitted:
                             occupancies(model, judged))
 
 
-def _settled(fit: Callable[[range], FitResult], bounds: tuple[int, int]) -> FitResult:
+def _settled(fit: Callable[[range], FitResult], model: EditableModel, bounds: tuple[int, int]) -> FitResult:
+    """``fit`` over the levels ``bounds`` (refused past the finest level of ``model``'s longest segment)."""
+    finest = max((ribbon.level for ribbon in model.ribbons), default=0)
+    if bounds[1] > finest:
+        raise InputError(f"--levels {bounds[0]}-{bounds[1]}: the finest level of {model.structure.path.name} is "
+                         f"{finest} (its longest segment at full resolution); give levels up to {finest}")
     try:
         return fit(range(bounds[0], bounds[1] + 1))
     except ValueError as error:
@@ -225,11 +234,13 @@ def run_morph(args: argparse.Namespace) -> int:
     if not 1 <= args.frames <= MAX_FRAMES:
         raise InputError(f"--frames must be between 1 and {MAX_FRAMES}; got {args.frames}")
     chain_a, chain_b = _chains(args.chains)
+    checked_output(args.output, args.overwrite)
     start = load(args.file_a)
     model = EditableModel(start)
     pairs, pairing, _ = _paired(model, chain_a, load(args.file_b), chain_b, args.pairing)
-    fits = _settled(lambda levels: fit_conformation(model, pairs, levels, regularize=False), args.levels).levels
-    frames = morph_frames(EditableModel(start), fits, args.frames)
+    fits = _settled(lambda levels: fit_conformation(model, pairs, levels, regularize=False), model, args.levels).levels
+    with tqdm(total=args.frames, unit="frame", desc="morphing", file=sys.stderr, mininterval=0.5) as progress:
+        frames = morph_frames(EditableModel(start), fits, args.frames, done=progress.update)
     try:
         written = write_models(start, frames, args.output, overwrite=args.overwrite)
     except FileExistsError as error:

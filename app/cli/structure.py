@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from collections import Counter
 from pathlib import Path
@@ -17,6 +18,7 @@ from app.arguments import bounded
 from app.errors import InputError
 from core.protein.reading import read_structure
 from core.protein.structure import Structure, StructureError
+from core.protein.writing import output_format
 
 MAX_MODEL = 100_000
 """Largest ``--model`` accepted before the file is read (PDB model serials stop at 9999)."""
@@ -32,6 +34,24 @@ def load(path: Path, model: int = 1) -> Structure:
     for warning in structure.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     return structure
+
+
+def checked_output(path: Path, overwrite: bool) -> None:
+    """Refuse, before any work, an output file the command could not write at the end: one
+    that exists (unless ``overwrite``), a folder, a missing or read-only folder, or (for a
+    structure) an unknown extension."""
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder")
+    if (path.exists() or path.is_symlink()) and not overwrite:
+        raise InputError(f"{path}: refusing to overwrite an existing file (pass --overwrite to replace it)")
+    if not path.parent.is_dir():
+        raise InputError(f"{path}: no such folder {path.parent}")
+    if not os.access(path.parent, os.W_OK | os.X_OK):
+        raise InputError(f"{path.parent}: cannot write in the folder (permission denied)")
+    try:
+        output_format(path)
+    except StructureError as error:
+        raise InputError(str(error)) from None
 
 
 def model_argument(parser: argparse.ArgumentParser) -> None:

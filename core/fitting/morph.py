@@ -41,9 +41,11 @@ def morph_frames(
     *,
     regularize: bool = True,
     cancelled: Callable[[], bool] = lambda: False,
+    done: Callable[[], object] = lambda: None,
 ) -> list[np.ndarray]:
     """Coordinates of every frame from ``start`` (its state before ``fits``, unchanged here)
-    along the levels of ``fits``: the first frame is ``start`` itself."""
+    along the levels of ``fits``: the first frame is ``start`` itself. ``done`` is called as
+    each frame after it is made (a progress bar)."""
     result = [start.coords.copy()]
     for fit, count in zip(fits, frame_counts(fits, frames)):
         for k in range(1, count + 1):
@@ -57,4 +59,5 @@ def morph_frames(
                     planned = regularized(start, planned, max_iterations=FIT_ITERATIONS)
                 coords[planned.rows] = planned.new_coords
             result.append(coords)
+            done()
     return result

@@ -88,7 +88,7 @@ def write_structure(
     """
     path = Path(path)
     coords = _checked_coords(structure, coords)
-    fmt, compress = _output_format(path)
+    fmt, compress = output_format(path)
     if fmt == "pdb":
         _check_pdb_columns(structure, coords, path)
     if not overwrite and path.exists():
@@ -123,7 +123,7 @@ def write_models(
     a movie. The header of the input is kept; the write is atomic. Raises as
     :func:`write_structure` does."""
     path = Path(path)
-    fmt, compress = _output_format(path)
+    fmt, compress = output_format(path)
     if not frames:
         raise StructureError(f"{path}: no frames to write")
     frames = [_checked_coords(structure, coords) for coords in frames]
@@ -177,7 +177,7 @@ def _check_pdb_columns(structure: Structure, coords: np.ndarray, path: Path) -> 
                                  "write mmCIF (.cif) instead")
 
 
-def _output_format(path: Path) -> tuple[str, bool]:
+def output_format(path: Path) -> tuple[str, bool]:
     """('pdb' | 'mmcif', gzip?) from the file name."""
     name = path.name.lower()
     compress = name.endswith(".gz")

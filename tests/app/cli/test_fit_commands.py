@@ -166,3 +166,36 @@ def test_a_fit_into_an_mtz_takes_the_files_resolution_and_judges_the_model(capsy
     assert np.sqrt(np.mean(np.sum((after - before) ** 2, axis=1))) < 0.5
     status, text, _ = run(capsys, "fit", UBIQUITIN, "--to", mtz, "-o", out, "--overwrite", "--levels", "6-6")
     assert status == 0 and "at 2.5 Å (the file's" in text and "the map's judgement: CC_mask" in text
+
+
+def test_what_cannot_end_well_is_refused_before_the_work(capsys, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """#37, items 7 and 9: levels past the finest (0-30 fitted 21 levels, Ramachandran outliers
+    2 -> 21), an output that cannot be written (found only after the whole fit), a constant map
+    (atoms moved 50 Å, exit 0); each refused before any fitting starts."""
+    import app.cli.fit
+
+    def no_fit(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the fit started")
+
+    monkeypatch.setattr(app.cli.fit, "fit_conformation", no_fit)
+    monkeypatch.setattr(app.cli.fit, "fit_map", no_fit)
+    status, _, err = run(capsys, "fit", CLOSED, "--to", OPEN, "--levels", "0-30", "-o", tmp_path / "x.pdb")
+    assert status == 1 and "--levels 0-30: the finest level of 1AKE_adk_closed.pdb.gz is 8" in err
+    status, _, err = run(capsys, "morph", CLOSED, OPEN, "--levels", "3-9", "-o", tmp_path / "m.pdb")
+    assert status == 1 and "give levels up to 8" in err
+    for output, reason in ((tmp_path / "missing" / "x.pdb", "no such folder"), (tmp_path / "x.txt", "unknown extension"),
+                           (tmp_path, "is a folder")):
+        for command in (["fit", CLOSED, "--to", OPEN], ["morph", CLOSED, OPEN], ["edit", CLOSED, "--chain", "A", "--level", "3", "--point", "3", "--move", "1,0,0"]):
+            status, _, err = run(capsys, *command, "-o", output)
+            assert status == 1 and reason in err, (command, err)
+    flat = tmp_path / "flat.mrc"
+    density = read_map(_simulated_map(OPEN, 10.0, tmp_path / "open.mrc"))
+    header = bytearray((tmp_path / "open.mrc").read_bytes()[:1024])
+    flat.write_bytes(bytes(header) + np.full(density.values.size, 0.25, dtype="<f4").tobytes())
+    status, _, err = run(capsys, "fit", CLOSED, "--to", flat, "--resolution", "10", "-o", tmp_path / "x.pdb")
+    assert status == 1 and "one value everywhere" in err and not (tmp_path / "x.pdb").exists()
+
+
+def test_morph_shows_its_progress(capsys, tmp_path: Path) -> None:
+    status, _, err = run(capsys, "morph", CLOSED, OPEN, "--frames", "4", "--levels", "4-5", "-o", tmp_path / "m.pdb")
+    assert status == 0 and "morphing" in err and "4/4" in err
