@@ -42,6 +42,7 @@ from core.analysis.database import (
     analyse_path,
     rms_crossing,
 )
+from core.protein.writing import process_alive
 
 NAMES = "backslashreplace"
 """How a file name that is not UTF-8 is written in a CSV: its odd bytes as Python names them
@@ -154,18 +155,8 @@ def _prepare_output(folder: Path, overwrite: bool) -> None:
         raise InputError(f"{folder}: cannot write in the folder (permission denied)")
     for stale in folder.glob(f"{STAGING_PREFIX}*"):
         pid = stale.name.removeprefix(STAGING_PREFIX).split("-")[0]
-        if stale.is_dir() and not stale.is_symlink() and pid.isdigit() and not _alive(int(pid)):
+        if stale.is_dir() and not stale.is_symlink() and pid.isdigit() and not process_alive(int(pid)):
             shutil.rmtree(stale, ignore_errors=True)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        pass  # another user's process
-    return True
 
 
 @contextlib.contextmanager

@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
-import tempfile
 import time
 from pathlib import Path
 
@@ -21,7 +20,7 @@ from app.errors import InputError
 from app.polydata import scalar_style, to_polydata
 from core.protein.reading import read_atoms
 from core.protein.structure import AtomTable, StructureError
-from core.protein.writing import new_file_mode
+from core.protein.writing import new_file_mode, staging_file
 from core.surfaces.dna import ideal_bdna
 from core.surfaces.levelled import KINDS, UNITS, LevelledSurface, build_surface
 from core.surfaces.map_file import MAP_SUFFIXES, read_map
@@ -123,7 +122,7 @@ def _site(atoms: AtomTable | None, spec: str) -> np.ndarray:
 def _write(mesh: TriangleMesh, scalars: np.ndarray | None, colouring: str | None, path: Path) -> None:
     """Write atomically: to a temporary file beside ``path``, then rename."""
     polydata = to_polydata(mesh, scalars, colouring or "values")
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=path.suffix)
+    fd, tmp = staging_file(path, path.suffix)
     os.close(fd)
     try:
         if path.suffix.lower() == ".png":
@@ -138,7 +137,7 @@ def _write(mesh: TriangleMesh, scalars: np.ndarray | None, colouring: str | None
         raise
 
 
-def _render(polydata, scalars: np.ndarray | None, colouring: str | None, path: str) -> None:  # noqa: ANN001
+def _render(polydata, scalars: np.ndarray | None, colouring: str | None, path: str) -> None:
     import pyvista as pv
 
     plotter = pv.Plotter(off_screen=True, window_size=(900, 900))

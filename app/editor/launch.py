@@ -160,6 +160,12 @@ def run_open(args: argparse.Namespace) -> int:
     images = [path for path in (args.screenshot, args.export_image) if path is not None]
     for path in images:
         _check_output(path, args.overwrite)
+    from app.editor.persistence.journal import checked_folder, state_folder
+
+    try:
+        checked_folder(state_folder())  # (unsaved edits are journalled there, and restored from there)
+    except OSError as error:
+        raise InputError(str(error)) from None
     app = QApplication.instance() or QApplication(sys.argv[:1])
     window = MainWindow()
     window.files.unattended = script is not None or bool(images)

@@ -380,6 +380,10 @@ def _patched_atom_site(structure: Structure, coords: np.ndarray) -> str | None:
     return "".join(lines)
 
 
+STAGING = ".staging-"
+"""In the name of a file being written (see :func:`staging_file`)."""
+
+
 def new_file_mode() -> int:
     """The permissions a new file gets under the process's umask (0o644 under the usual 022,
     0o600 under 077): a temporary file renamed into place is made with 0o600 whatever the umask."""
@@ -388,11 +392,34 @@ def new_file_mode() -> int:
     return 0o666 & ~umask
 
 
+def staging_file(path: Path, suffix: str = ".tmp") -> tuple[int, str]:
+    """A new file beside ``path`` (descriptor and name) for its content until it is renamed onto
+    it, named ``.NAME.staging-PID-…``; the staging files in that folder of processes that have
+    ended (killed mid-write) are removed first."""
+    for stale in path.parent.glob(f".*{STAGING}*"):
+        pid = stale.name.partition(STAGING)[2].split("-")[0]
+        if pid.isdigit() and not process_alive(int(pid)) and stale.is_file() and not stale.is_symlink():
+            with contextlib.suppress(OSError):
+                stale.unlink()
+    return tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}{STAGING}{os.getpid()}-", suffix=suffix)
+
+
+def process_alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (another user's included)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        pass  # another user's process
+    return True
+
+
 def atomic_write(path: Path, data: bytes) -> None:
     """Write ``data`` to a temporary file next to ``path``, then rename it onto ``path`` (a new
     file gets the permissions the umask allows, a replaced one keeps its own)."""
     mode = path.stat().st_mode & 0o777 if path.exists() else new_file_mode()
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    fd, tmp = staging_file(path)
     try:
         with os.fdopen(fd, "wb") as out:
             out.write(data)

@@ -45,6 +45,20 @@ def state_folder() -> Path:
     return Path(base) / "ribbonwave"
 
 
+def checked_folder(folder: Path) -> Path:
+    """``folder``, made private (mode 0700) if missing; raises PermissionError unless it is the
+    user's own and no one else may write in it (a journal there is restored as the user's work)."""
+    folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+    info = folder.stat()
+    if info.st_uid != os.getuid():
+        raise PermissionError(f"the folder of recovery journals {folder} belongs to another user (uid {info.st_uid}); "
+                              "set XDG_STATE_HOME to a folder of your own")
+    if info.st_mode & 0o022:
+        raise PermissionError(f"the folder of recovery journals {folder} may be written by other users (mode "
+                              f"{info.st_mode & 0o777:o}); make it yours alone: chmod go-w {folder}")
+    return folder
+
+
 class Journal(QObject):
     """Journals every step of ``document`` to a file of its own in ``folder``."""
 
@@ -142,7 +156,7 @@ class Journal(QObject):
             self._write(records.Record("state", {k: state[k] for k in ("level", "segment", "multiresolution")}))
 
     def _open_file(self) -> None:
-        self.folder.mkdir(parents=True, exist_ok=True)
+        self.folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         stem = f"journal-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}-{id(self):x}"
         for again in itertools.count():  # a journal kept within the same second keeps its name
             self.path = self.folder / f"{stem}{f'-{again}' if again else ''}{SUFFIX}"
@@ -189,8 +203,8 @@ def sweep(folder: Path | None = None) -> tuple[list[Path], list[Path]]:
     """The journals left by editors that ended without closing cleanly, newest first, and those
     set aside now: a journal nobody holds that holds no undo step is deleted; one whose steps
     cannot be read (a newer format, a damaged header) is renamed with :data:`SET_ASIDE`, never
-    deleted."""
-    folder = state_folder() if folder is None else Path(folder)
+    deleted. Raises PermissionError for a folder that is not the user's alone (:func:`checked_folder`)."""
+    folder = checked_folder(state_folder() if folder is None else Path(folder))
     found, aside = [], []
     for path in folder.glob(f"*{SUFFIX}"):
         try:

@@ -349,3 +349,28 @@ def test_recover_with_nothing_to_restore_names_the_journals_set_aside(qtbot: QtB
     assert main(["--recover"]) == 1
     assert capsys.readouterr().err.strip().endswith(f"(kept there, unreadable here: journal-1{journal.SUFFIX}"
                                                     f"{journal.SET_ASIDE})")
+
+
+@pytest.mark.parametrize("wrong", ["another owner", "writable by others"])
+def test_a_state_folder_that_is_not_the_users_alone_is_refused(state_home: Path, tmp_path: Path, wrong: str,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """A journal found there is restored as the user's own work, and a sweep deletes files
+    there: another user's folder, or one others may write in, is refused (#37, item 6)."""
+    from app.main import main
+
+    state_home.mkdir(parents=True, exist_ok=True)
+    if wrong == "another owner":
+        os.chown(state_home, 54321, -1)
+    else:
+        state_home.chmod(0o777)
+    assert main([str(DATA / "1UBQ.pdb.gz"), "--screenshot", str(tmp_path / "x.png")]) == 1
+    err = capsys.readouterr().err
+    assert f"the folder of recovery journals {state_home}" in err and "Traceback" not in err
+    assert ("belongs to another user" if wrong == "another owner" else "chmod go-w") in err
+    with pytest.raises(PermissionError):
+        journal.sweep(state_home)
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_a_new_state_folder_is_private(state_home: Path) -> None:
+    assert journal.checked_folder(state_home) == state_home and state_home.stat().st_mode & 0o777 == 0o700
