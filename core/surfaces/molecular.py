@@ -38,6 +38,8 @@ PROBE_RADIUS = 1.4
 
 MAX_GRID_POINTS = 12_000_000
 """The default grid spacing grows beyond 0.5 Å when a finer grid would have more points."""
+MAX_SPACING = 4.0
+"""Å: the coarsest default grid step; atoms spread wider than it can serve are refused."""
 
 BONDI_RADII = {
     "H": 1.20, "C": 1.70, "N": 1.55, "O": 1.52, "F": 1.47, "P": 1.80, "S": 1.80, "CL": 1.75,
@@ -279,6 +281,10 @@ def ses_field(
     size = coords.max(axis=0) - coords.min(axis=0)
     if spacing is None:
         spacing = max(0.5, float(np.cbrt(np.prod(size + 2 * (radii.max() + probe + 3)) / MAX_GRID_POINTS)))
+        if spacing > MAX_SPACING:
+            raise ValueError(f"the atoms span {' × '.join(f'{v:.3g}' for v in size)} Å: a surface with a grid step of "
+                             f"{MAX_SPACING:g} Å or finer would need more than {MAX_GRID_POINTS:,} points (is a "
+                             "coordinate far off?); surface a chain or a part of it instead")
     if not spacing > 0:
         raise ValueError(f"spacing must be positive; got {spacing}")
     cap = 3 * spacing

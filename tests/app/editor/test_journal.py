@@ -353,14 +353,16 @@ def test_recover_with_nothing_to_restore_names_the_journals_set_aside(qtbot: QtB
 
 @pytest.mark.parametrize("wrong", ["another owner", "writable by others"])
 def test_a_state_folder_that_is_not_the_users_alone_is_refused(state_home: Path, tmp_path: Path, wrong: str,
-                                                              capsys: pytest.CaptureFixture[str]) -> None:
+                                                              capsys: pytest.CaptureFixture[str],
+                                                              monkeypatch: pytest.MonkeyPatch) -> None:
     """A journal found there is restored as the user's own work, and a sweep deletes files
     there: another user's folder, or one others may write in, is refused (#37, item 6)."""
     from app.main import main
 
     state_home.mkdir(parents=True, exist_ok=True)
-    if wrong == "another owner":
-        os.chown(state_home, 54321, -1)
+    if wrong == "another owner":  # (as another user sees it: the folder's owner is not the process's user)
+        uid = state_home.stat().st_uid
+        monkeypatch.setattr(journal.os, "getuid", lambda: uid + 1)
     else:
         state_home.chmod(0o777)
     assert main([str(DATA / "1UBQ.pdb.gz"), "--screenshot", str(tmp_path / "x.png")]) == 1

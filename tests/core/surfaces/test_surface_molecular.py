@@ -125,3 +125,12 @@ def test_bad_input_is_rejected() -> None:
         ses_field([[0, np.nan, 0]], [1.0])
     with pytest.raises(ValueError, match="positive"):
         ses_field([[0, 0, 0]], [1.0], probe=0)
+
+
+def test_atoms_spread_past_any_sensible_grid_are_refused_at_once() -> None:
+    """A coordinate of 1e8 Å made the default grid step 400 km and the surface run for minutes
+    (or try 1 TiB at a fixed step); it is refused before any grid is made (#37)."""
+    coords = np.array([[0.0, 0.0, 0.0], [1.5, 0.0, 0.0], [1e8, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="the atoms span 1e\\+08 × 0 × 0 Å.*far off"):
+        ses_field(coords, np.full(3, 1.7))
+    assert ses_field(coords[:2], np.full(2, 1.7)).spacing == 0.5
