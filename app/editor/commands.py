@@ -23,14 +23,22 @@ class Edited(Protocol):
 
 class EditCommand(QUndoCommand):
     """One step: the edit of one segment (a whole drag), or of several at once (a level of a
-    fit of a chain); redo applies them in turn, undo restores them exactly."""
+    fit of a chain); redo applies them in turn, undo restores them exactly. ``applied``: the
+    document already shows them, so the first redo (QUndoStack.push's) does nothing."""
 
-    def __init__(self, document: Edited, edits: Edit | Sequence[Edit], text: str) -> None:
+    def __init__(self, document: Edited, edits: Edit | Sequence[Edit], text: str, *, applied: bool = False) -> None:
         super().__init__(text)
         self.document = document
         self.edits = (edits,) if isinstance(edits, Edit) else tuple(edits)
+        self.nbytes = sum(getattr(edit, name).nbytes for edit in self.edits for name in
+                          ("old_points", "new_points", "residues", "rows", "old_coords", "new_coords"))
+        """Bytes its edits hold."""
+        self._applied = applied
 
     def redo(self) -> None:
+        if self._applied:
+            self._applied = False
+            return
         for edit in self.edits:
             self.document.apply_edit(edit)
 

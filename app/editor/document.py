@@ -26,7 +26,7 @@ import numpy as np
 from PySide6.QtCore import QObject, QSignalBlocker, Signal
 from PySide6.QtGui import QUndoStack
 
-from app.editor.commands import EditCommand
+from app.editor.history import History
 from app.editor.measurements import Measurements
 from app.editor.scene.curves import LevelCurve, SegmentPath, segment_paths
 from core.geometry.regularize import FLANK, regularize_region, regularized
@@ -75,11 +75,15 @@ class Document(QObject):
     """The file name, the save target or the modified state changed."""
     selectionChanged = Signal()
     """The selected residues changed (see :attr:`selection`)."""
+    saved = Signal()
+    """The structure was saved (:meth:`save`)."""
 
     def __init__(self, parent: QObject | None = None) -> None:
         super().__init__(parent)
         self.undo_stack = QUndoStack(self)
         self.undo_stack.cleanChanged.connect(self.fileChanged)
+        self.history = History(self)
+        """The undo steps within a memory budget (pushed there, undone and redone on the stack)."""
         self.model: EditableModel | None = None
         self.paths: list[SegmentPath] = []
         self.ca_rows = np.empty(0, dtype=np.int64)
@@ -312,7 +316,7 @@ class Document(QObject):
         if edit is not None and not np.array_equal(edit.old_points, edit.new_points):
             if self.regularize_on_release and not self.regularize_while_dragging:  # else the preview is regularized
                 edit = regularized(self._model, edit)
-            self.undo_stack.push(EditCommand(self, edit, text))
+            self.history.push(edit, text)
 
     def cancel_drag(self) -> None:
         """End a drag without an edit: put everything back where it was."""
@@ -327,13 +331,13 @@ class Document(QObject):
         self._check_editable()
         edit = regularize_region(self._model, self.segment, residues, flank=FLANK)
         if not np.array_equal(edit.old_coords, edit.new_coords):
-            self.undo_stack.push(EditCommand(self, edit, f"Regularize {self.residue_range(edit.residues)}"))
+            self.history.push(edit, f"Regularize {self.residue_range(edit.residues)}")
 
     def push_applied(self, edits: Sequence[Edit], text: str) -> None:
         """Make ``edits``, which a fit already applied to the model, one undo step named ``text``."""
         for edit in reversed(edits):
             self._model.revert(edit)
-        self.undo_stack.push(EditCommand(self, edits, text))
+        self.history.push(edits, text)
 
     def apply_edit(self, edit: Edit) -> None:
         """Carry out ``edit`` (undo commands call this)."""
@@ -352,6 +356,7 @@ class Document(QObject):
         self.path = self.save_path = Path(written)
         self.undo_stack.setClean()
         self.fileChanged.emit()
+        self.saved.emit()
         return written
 
     # ------------------------------------------------------------------ recordings
@@ -390,7 +395,7 @@ class Document(QObject):
         segment, level = self.segment, self.level
         if self.model is None or model.structure is not self.model.structure:
             self.measurements.replace([])  # (their rows name other atoms)
-        self.undo_stack.clear()
+        self.history.reset()
         self.model = model
         model.carry_ligands = self.carry_ligands
         self.paths = segment_paths(model.ribbons)

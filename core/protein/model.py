@@ -8,7 +8,7 @@ and redone bit for bit. Atoms of residues the edit does not reach are never rewr
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -143,6 +143,12 @@ class EditableModel:
         """Carry out ``edit`` (redo)."""
         self.coords[edit.rows] = edit.new_coords
         self.ribbons[edit.segment] = self.ribbons[edit.segment].with_points(edit.new_points)
+
+    def reset_to(self, coords: np.ndarray, points: Sequence[np.ndarray]) -> None:
+        """Make ``coords`` the coordinates and ``points`` each segment's finest control points
+        (where an undo history starts once its oldest steps were dropped)."""
+        self.coords[:] = coords
+        self.ribbons = [ribbon.with_points(p) for ribbon, p in zip(self.ribbons, points, strict=True)]
 
     def check(self, edit: Edit) -> None:
         """Raise ValueError unless ``edit`` was made on the model as it is now: its segment,

@@ -2,12 +2,15 @@
 
 A journal lives in :func:`state_folder` from the first undo step of a structure until the
 document is closed cleanly (saved, or its edits discarded). It starts with the file as
-read and then gets one record per step: each new undo step as the deltas of its
+read (and where the undo history starts, once its oldest steps were dropped) and then gets one
+record per step: each new undo step as the deltas of its
 :class:`~core.protein.model.Edit`, each undo or redo as the new stack position, and the
 level and segment shortly after they change (:mod:`app.editor.persistence.records`). Every record goes
 to the operating system at once, so a kill loses at most the step being written, and to
 the disk within :data:`SYNC_DELAY_MS` (in a background thread). A running editor holds a
-lock on its journal; a journal nobody holds was left by a crash (:func:`orphans`).
+lock on its journal; a journal nobody holds was left by a crash (:func:`orphans`). On a save,
+and when the history drops its oldest steps, the journal is rewritten as the history then is,
+so that it grows no larger than the history.
 """
 
 from __future__ import annotations
@@ -84,6 +87,8 @@ class Journal(QObject):
         document.undo_stack.cleanChanged.connect(self._step)
         document.levelChanged.connect(self._state_changed)
         document.segmentChanged.connect(self._state_changed)
+        document.history.trimmed.connect(self._compact)
+        document.saved.connect(self._compact)
 
     def discard(self) -> None:
         """Close and delete the journal (the document was closed cleanly)."""
@@ -116,8 +121,15 @@ class Journal(QObject):
             self._open_file()
             self._write(*recording.recording(self.document)[1:])
             self._mirror = [stack.command(k) for k in range(stack.count())]
+            self._last = recording.state(self.document)
 
     # ------------------------------------------------------------------ internals
+
+    def _compact(self) -> None:
+        """The journal rewritten as the history now is (after a save, or once its oldest steps
+        were dropped): steps undone and replaced, and older positions, are left behind."""
+        if self._fd is not None and not self.document.replaying:
+            self.write_all()
 
     def _restart(self) -> None:
         """A new structure: the old journal is done with (the window asked about its edits)."""

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from app.editor.commands import EditCommand
 from app.editor.document import Document
+from app.editor.history import Base
 from app.editor.persistence import records
 
 
@@ -23,11 +23,12 @@ def state(document: Document) -> dict:
 
 
 def recording(document: Document) -> list[records.Record]:
-    """``document`` as records: the file as read, every undo step, the current state."""
-    stack = document.undo_stack
+    """``document`` as records: the file as read, where the history starts (if its oldest steps
+    were dropped), every undo step, the current state."""
+    stack, start = document.undo_stack, document.history.base
     steps = [records.push(k, stack.text(k), stack.command(k).edits) for k in range(stack.count())]
-    return [records.header(document.path, document.kind.value, document.source, document.model_number), *steps,
-            records.Record("index", state(document))]
+    return [records.header(document.path, document.kind.value, document.source, document.model_number),
+            *([] if start is None else [records.base(start)]), *steps, records.Record("index", state(document))]
 
 
 def replay(document: Document, recording: list[records.Record]) -> list[str]:
@@ -42,10 +43,18 @@ def replay(document: Document, recording: list[records.Record]) -> list[str]:
         document.open(Path(head["path"]), head["kind"], records.source_of(recording[0]), records.model_of(head))
         stack = document.undo_stack
         for record in recording[1:]:
-            if record.kind == "push":
+            if record.kind == "base":
+                reason = "it comes after steps" if stack.count() else _unfit_base(document, records.base_of(record))
+                if reason is None:
+                    start = records.base_of(record)
+                    document.model.reset_to(start.coords, start.points)
+                    document.history.reset(start)
+                else:
+                    left_out.append(f"where the history starts: {reason}")
+            elif record.kind == "push":
                 reason = _unfit(document, record)
                 if reason is None:
-                    stack.push(EditCommand(document, records.edits_of(record), record.fields["text"]))
+                    document.history.push(records.edits_of(record), record.fields["text"])
                 else:
                     left_out.append(f"step {record.fields['at'] + 1} ({record.fields['text'][:60]}): {reason}")
             elif record.kind == "index":
@@ -61,6 +70,15 @@ def replay(document: Document, recording: list[records.Record]) -> list[str]:
             document.multiresolution = bool(view["multiresolution"])
             document.level = float(np.clip(view["level"], 0.0, document.max_level))
     return left_out
+
+
+def _unfit_base(document: Document, start: Base) -> str | None:
+    """Why ``start`` cannot be where the history of ``document`` starts (None: it can)."""
+    model = document.model
+    if start.coords.shape != model.coords.shape or [p.shape for p in start.points] != \
+            [ribbon.points.shape for ribbon in model.ribbons]:
+        return "its atoms or control points are not the structure's"
+    return None
 
 
 def _unfit(document: Document, record: records.Record) -> str | None:

@@ -10,7 +10,8 @@ bytes in the middle are passed over to the next record whose CRC holds, and each
 checked against its kind's rules (:mod:`app.editor.persistence.schema`) before it is used.
 
 Kinds: ``header`` (format version, file name, ribbon kind, model, the file's bytes as read),
-``push`` (an undo step pushed at a stack position: its text and the
+``base`` (where the undo history starts once its oldest steps were dropped: coordinates and
+control points), ``push`` (an undo step pushed at a stack position: its text and the
 :class:`~core.protein.model.Edit` of each segment it changed), ``index`` (the stack
 position after a step, undo or redo, the clean position, the file names, the level,
 segment and multiresolution switch), ``state`` (level, segment and multiresolution switch
@@ -32,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from app.editor.history import Base
 from app.editor.persistence import schema
 from core.protein.model import Edit
 from core.protein.reading import input_limit, limit_text
@@ -185,6 +187,19 @@ def header(path: Path, kind: str, source: bytes, model: int) -> Record:
     """The first record: the file as read, its name, the ribbon kind and the model (from 1) edited."""
     return Record("header", {"version": VERSION, "path": str(path), "kind": kind, "model": model},
                   {"source": np.frombuffer(source, dtype=np.uint8)})
+
+
+def base(start: Base) -> Record:
+    """Where the undo history starts once its oldest steps were dropped: the coordinates and each
+    segment's finest control points."""
+    return Record("base", {"segments": len(start.points)},
+                  {"coords": start.coords, **{f"points.{k}": points for k, points in enumerate(start.points)}})
+
+
+def base_of(record: Record) -> Base:
+    """The :class:`~app.editor.history.Base` of a ``base`` record."""
+    return Base(record.arrays["coords"].astype(np.float64),
+                [record.arrays[f"points.{k}"].astype(np.float64) for k in range(record.fields["segments"])])
 
 
 def model_of(fields: dict) -> int:

@@ -169,6 +169,13 @@ def _push(fields: dict, arrays: dict[str, np.ndarray]) -> None:
         array(arrays, f"{prefix}new_coords", "f", (len(rows), 3))
 
 
+def _base(fields: dict, arrays: dict[str, np.ndarray]) -> None:
+    segments = integer(fields, "segments", 0, MAX_ITEMS)
+    array(arrays, "coords", "f", (None, 3))
+    for k in range(segments):
+        array(arrays, f"points.{k}", "f", (None, 3))
+
+
 def _state(fields: dict, arrays: dict[str, np.ndarray]) -> None:
     number(fields, "level", 0.0, 64.0)
     integer(fields, "segment")
@@ -202,4 +209,4 @@ def _view(fields: dict, arrays: dict[str, np.ndarray]) -> None:
 
 
 _KINDS: dict[str, Callable[[dict, dict[str, np.ndarray]], None]] = {
-    "header": _header, "push": _push, "index": _index, "state": _state, "view": _view}
+    "header": _header, "base": _base, "push": _push, "index": _index, "state": _state, "view": _view}

@@ -238,7 +238,7 @@ def _mutation(draw: st.DrawFn, entries: list[records.Record]) -> list[records.Re
                 values.flat[draw(st.integers(0, values.size - 1))] = value  # (wrapped into the array's type)
             arrays[name] = values
         elif what == "kind":
-            entry = records.Record(draw(st.sampled_from(["header", "push", "index", "state", "view", "x"])),
+            entry = records.Record(draw(st.sampled_from(["header", "base", "push", "index", "state", "view", "x"])),
                                    fields, arrays)
             entries[k] = entry
             continue
