@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import io
 import zipfile
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -63,11 +64,12 @@ RANK_BLOCK = 8192
 """Index rows ranked at once."""
 MIN_RESIDUES = 20
 """Chains with fewer residues are not indexed (peptides have no fold to search)."""
-FORMAT = 2
-"""Version of the index file (2: uncompressed, the coordinates and sequences mapped)."""
+FORMAT = 3
+"""Version of the index file (2: uncompressed, the coordinates and sequences mapped; 3: a
+checksum of each chain's coordinates and sequence)."""
 SCREEN_STEP = 4
 """The candidates of :func:`search` are screened by aligning every 4th Cα of each chain."""
-FIELDS = ("format", "entries", "chains", "paths", "lengths", "descriptors", "coordinates", "sequences")
+FIELDS = ("format", "entries", "chains", "paths", "lengths", "descriptors", "checksums", "coordinates", "sequences")
 REBUILD = "index the files again (ribbonwave index FILE... -o DB --overwrite)"
 """What a damaged or empty index asks for."""
 
@@ -108,6 +110,7 @@ class FoldIndex:
     entries, chains, paths : (n,) str: the entry id, chain id and file of each chain.
     lengths : (n,) int64 residues.
     descriptors : (n, DESCRIPTOR_SIZE) float16 (:func:`curve_descriptor`).
+    checksums : (n,) uint32 CRC-32 of each chain's coordinates and sequence (:func:`checksum`).
     coordinates : (lengths.sum(), 3) float32 Cα of every chain, one after another, Å.
     sequences : (lengths.sum(),) one-letter residue codes (bytes), in the same order.
     """
@@ -117,6 +120,7 @@ class FoldIndex:
     paths: np.ndarray
     lengths: np.ndarray
     descriptors: np.ndarray
+    checksums: np.ndarray
     coordinates: np.ndarray
     sequences: np.ndarray
 
@@ -132,11 +136,15 @@ class FoldIndex:
         """The Cα (float64) and one-letter codes of chain ``k``; ValueError where the file's
         coordinates of it are not finite numbers (a damaged index: they are read only now)."""
         rows = slice(int(self.starts[k]), int(self.starts[k] + self.lengths[k]))
-        ca = np.asarray(self.coordinates[rows], dtype=np.float64)
+        stored, sequence = np.asarray(self.coordinates[rows]), np.asarray(self.sequences[rows])
+        ca = stored.astype(np.float64)
         if not np.isfinite(ca).all():
             raise ValueError(f"a damaged fold index: chain {k} ({self.entries[k]}:{self.chains[k]}) has non-finite "
                              f"coordinates; {REBUILD}")
-        return ca, np.asarray(self.sequences[rows])
+        if checksum(stored, sequence) != self.checksums[k]:
+            raise ValueError(f"a damaged fold index: the coordinates or sequence of chain {k} ({self.entries[k]}:"
+                             f"{self.chains[k]}) changed since it was indexed; {REBUILD}")
+        return ca, sequence
 
     def to_bytes(self) -> bytes:
         """The index as an uncompressed ``.npz`` archive of plain arrays (no pickled objects), so
@@ -153,8 +161,8 @@ class FoldIndex:
             with np.load(path, allow_pickle=False) as archive:
                 if int(archive["format"]) != FORMAT:
                     raise ValueError(f"{path}: a fold index of another format version (index the files again)")
-                arrays = {name: archive[name] for name in FIELDS[1:6]}
-            arrays |= {name: _mapped(path, name) for name in FIELDS[6:]}
+                arrays = {name: archive[name] for name in FIELDS[1:7]}
+            arrays |= {name: _mapped(path, name) for name in FIELDS[7:]}
         except (OSError, KeyError, EOFError, zipfile.BadZipFile) as error:
             raise ValueError(f"{path}: not a ribbonwave fold index ({type(error).__name__}: {error})") from None
         except ValueError as error:
@@ -167,7 +175,7 @@ class FoldIndex:
             raise ValueError(f"{path}: a fold index of no chain; {REBUILD}")
         residues = int(index.lengths.sum())
         if (index.descriptors.shape != (n, DESCRIPTOR_SIZE) or len(index.lengths) != n or len(index.chains) != n
-                or len(index.coordinates) != residues or len(index.sequences) != residues):
+                or index.checksums.shape != (n,) or len(index.coordinates) != residues or len(index.sequences) != residues):
             raise ValueError(f"{path}: a damaged fold index (its arrays disagree); {REBUILD}")
         if (index.lengths < MIN_RESIDUES).any() or not np.isfinite(index.descriptors).all():
             raise ValueError(f"{path}: a damaged fold index (chains shorter than {MIN_RESIDUES} residues or "
@@ -210,6 +218,8 @@ def index_structure(structure: Structure, path: Path | str = "") -> FoldIndex:
             names.append(name)
             coordinates.append(ca)
             sequences.append("".join(s.sequence for s in segments))
+    coordinates = [ca.astype(np.float32) for ca in coordinates]
+    codes = [np.frombuffer(text.encode("ascii", "replace"), dtype="S1") for text in sequences]
     return FoldIndex(
         entries=np.array([structure.entry_id] * len(names), dtype=str).reshape(-1),
         chains=np.array(names, dtype=str).reshape(-1),
@@ -217,9 +227,15 @@ def index_structure(structure: Structure, path: Path | str = "") -> FoldIndex:
         lengths=np.array([len(ca) for ca in coordinates], dtype=np.int64),
         descriptors=np.array([curve_descriptor(ca) for ca in coordinates], dtype=np.float16).reshape(
             -1, DESCRIPTOR_SIZE),
-        coordinates=np.concatenate(coordinates or [np.zeros((0, 3))]).astype(np.float32),
-        sequences=np.frombuffer("".join(sequences).encode("ascii", "replace"), dtype="S1").copy(),
+        checksums=np.array([checksum(ca, code) for ca, code in zip(coordinates, codes)], dtype=np.uint32),
+        coordinates=np.concatenate(coordinates or [np.zeros((0, 3), dtype=np.float32)]),
+        sequences=np.concatenate(codes or [np.zeros(0, dtype="S1")]),
     )
+
+
+def checksum(coordinates: np.ndarray, sequence: np.ndarray) -> int:
+    """CRC-32 of a chain's float32 Cα and one-letter codes as the index stores them."""
+    return zlib.crc32(np.ascontiguousarray(sequence).tobytes(), zlib.crc32(np.ascontiguousarray(coordinates).tobytes()))
 
 
 def index_path(path: Path) -> FoldIndex | SkippedFile:

@@ -129,6 +129,8 @@ def test_bad_input(argv, message, tmp_path, capsys):
     ("a chain of 0 residues", "chains shorter than 20 residues"),
     ("infinite coordinates", "non-finite coordinates"),
     ("lengths that disagree", "its arrays disagree"),
+    ("a flipped bit in the coordinates", "changed since it was indexed"),
+    ("a residue renamed", "changed since it was indexed"),
 ])
 def test_a_damaged_index_asks_to_be_built_again(index_file, tmp_path, capsys, damage, message):
     """Each of these gave a traceback (ZeroDivisionError, IndexError, ...); each now says what is
@@ -145,6 +147,10 @@ def test_a_damaged_index_asks_to_be_built_again(index_file, tmp_path, capsys, da
         arrays["lengths"][1], arrays["lengths"][2] = 0, arrays["lengths"][1] + arrays["lengths"][2]
     elif damage == "infinite coordinates":
         arrays["coordinates"][:] = np.inf
+    elif damage == "a flipped bit in the coordinates":  # every chain: whichever the search reads is damaged
+        arrays["coordinates"].view(np.uint32)[::7] ^= 1 << 12
+    elif damage == "a residue renamed":
+        arrays["sequences"][::5] = b"X"
     else:
         arrays["lengths"][0] += 5
     damaged = tmp_path / "damaged.npz"
