@@ -124,7 +124,10 @@ class MainWindow(QMainWindow):
         self.measurements_panel = MeasurementsPanel(self.document)
         self.help = Help(self, self.menus)
         self.history = QUndoView(self.document.undo_stack)
-        self.history.setEmptyLabel("<structure as read>")
+        self.history.setUniformItemSizes(True)  # (one line a step: a history of thousands lays out at once)
+        self._name_history_start()
+        self.document.loaded.connect(self._name_history_start)
+        self.document.history.trimmed.connect(self._name_history_start)
         self.rw = EditorAPI(self)
         """The ``rw`` object of scripts and of the Python console."""
         self.console = PythonConsole({"rw": self.rw, "np": np})
@@ -137,6 +140,11 @@ class MainWindow(QMainWindow):
                                  select=self.navigation.select, name=self.status.labels["hover"].setText,
                                  measure=self.measuring.click)
         restore_layout(self, self.settings)
+
+    def _name_history_start(self) -> None:
+        """The History dock's first row: the structure as read, or where the history starts now."""
+        dropped = self.document.history.base is not None
+        self.history.setEmptyLabel("<older steps dropped>" if dropped else "<structure as read>")
 
     def quit_unattended(self, discard: bool = False) -> None:
         """Close without asking: unsaved edits are kept in the journal unless ``discard``."""

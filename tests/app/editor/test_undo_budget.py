@@ -102,3 +102,15 @@ def test_a_save_kept_in_the_history_stays_marked_and_compacts_the_journal(qtbot:
     stack.setIndex(stack.cleanIndex())
     assert not document.modified
     assert journal.orphans(window.journal.folder) == []
+
+
+def test_the_history_dock_names_its_start_and_stays_fast(qtbot: QtBot, small_budget: None) -> None:
+    window = _window(qtbot, DATA / "1UBQ.pdb.gz")
+    window.document.set_regularization(on_release=False)
+    assert window.history.emptyLabel() == "<structure as read>" and window.history.uniformItemSizes()
+    window.document.history.budget = 300_000
+    _steps(window, 40)
+    assert window.document.history.base is not None and window.history.emptyLabel() == "<older steps dropped>"
+    assert window.history.model().rowCount() == window.document.undo_stack.count() + 1
+    window.files.open_file(DATA / "1L2Y.pdb.gz")
+    assert window.history.emptyLabel() == "<structure as read>"
