@@ -11,16 +11,22 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 from PySide6.QtCore import QObject, QSignalBlocker, Signal
+from PySide6.QtGui import QUndoStack
 
-from app.editor.commands import EditCommand
-from core.protein.model import Edit
+from app.editor.commands import EditCommand, Edited
+from core.protein.model import Edit, EditableModel
 
-if TYPE_CHECKING:
-    from app.editor.document import Document
+
+class Documented(Edited, Protocol):
+    """What a history keeps the steps of: the :class:`~app.editor.document.Document` (a QObject),
+    its undo stack and its model."""
+
+    undo_stack: QUndoStack
+    model: EditableModel | None
 
 UNDO_BUDGET = 200 * 2**20
 """Bytes of edits the undo history holds at most (its oldest steps dropped past it)."""
@@ -44,7 +50,7 @@ class History(QObject):
     trimmed = Signal(int)
     """Steps were dropped from the bottom of the history (their number): :attr:`base` moved."""
 
-    def __init__(self, document: Document) -> None:
+    def __init__(self, document: Documented) -> None:
         super().__init__(document)
         self.document = document
         self.budget = UNDO_BUDGET
