@@ -75,15 +75,13 @@ class Document(QObject):
     """The file name, the save target or the modified state changed."""
     selectionChanged = Signal()
     """The selected residues changed (see :attr:`selection`)."""
-    saved = Signal()
-    """The structure was saved (:meth:`save`)."""
+    saved = Signal()  # (by :meth:`save`)
 
     def __init__(self, parent: QObject | None = None) -> None:
         super().__init__(parent)
         self.undo_stack = QUndoStack(self)
         self.undo_stack.cleanChanged.connect(self.fileChanged)
-        self.history = History(self)
-        """The undo steps within a memory budget (pushed there, undone and redone on the stack)."""
+        self.history = History(self)  # (steps are pushed there; undone and redone on the stack)
         self.model: EditableModel | None = None
         self.paths: list[SegmentPath] = []
         self.ca_rows = np.empty(0, dtype=np.int64)
