@@ -1,5 +1,6 @@
-"""Fold search commands: ``index`` (descriptors of the low-level curves of every protein chain
-of many files, in one file) and ``search`` (the chains of an index nearest a query's fold).
+"""Fold search commands: ``index`` (the 3Di states, sequence, Cα and curve descriptors of every
+protein chain of many files, in one file) and ``search`` (the chains of an index most like a
+query's fold, with E-values and TM-scores).
 Core does the science (:mod:`core.analysis.fold_search`); this module reads arguments, runs
 files in parallel as ``analyze`` does, writes the index and prints.
 
@@ -23,7 +24,19 @@ from app.cli.batch import batch_arguments, run_tasks, structure_paths
 from app.cli.structure import load
 from app.errors import InputError
 from core.analysis.database import SkippedFile
-from core.analysis.fold_search import DESCRIPTOR_SIZE, MIN_RESIDUES, FoldIndex, index_path, merge, search
+from core.analysis.fold_search import (
+    ALIGNED,
+    DESCRIPTOR_SIZE,
+    MAX_EVALUE,
+    MIN_RESIDUES,
+    SCORED,
+    TOP,
+    FoldIndex,
+    Hit,
+    index_path,
+    merge,
+    search,
+)
 from core.protein.structure import Structure
 from core.protein.writing import atomic_write
 
@@ -69,7 +82,7 @@ def run_index(args: argparse.Namespace) -> int:
         raise InputError(f"{output}: cannot write ({error.strerror or error})") from None
     print(f"indexed {len(index)} chains of {len(found)} file(s) in {time.perf_counter() - start:.1f} s"
           + (f"; skipped {len(skipped)} file(s)" if skipped else ""))
-    print(f"wrote {output} ({len(data) / 1e6:.2f} MB; descriptors {2 * DESCRIPTOR_SIZE} bytes per chain)")
+    print(f"wrote {output} ({len(data) / 1e6:.2f} MB; {2 * DESCRIPTOR_SIZE} bytes a chain and 14 a residue)")
     return 0
 
 
@@ -80,13 +93,13 @@ def search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("query", metavar="QUERY[:CHAIN]",
                         help="structure file of the query, optionally with a chain (default: its longest chain)")
     parser.add_argument("index", type=Path, metavar="DB", help="an index written by 'ribbonwave index'")
-    parser.add_argument("--top", type=bounded(int, 1, 10000), default=10, metavar="K",
-                        help="hits to print (default %(default)s)")
-    parser.add_argument("--candidates", type=bounded(int, 1, 100000), default=60, metavar="C",
-                        help="chains nearest the query's descriptor that are screened by aligning every 4th Cα "
+    parser.add_argument("--top", type=bounded(int, 1, 100000), default=TOP, metavar="K",
+                        help="hits to list at most (default %(default)s)")
+    parser.add_argument("--aligned", type=bounded(int, 1, 100000), default=ALIGNED, metavar="A",
+                        help="chains of best alignment score that are aligned by structure (default %(default)s)")
+    parser.add_argument("--max-evalue", type=bounded(float, 0.0, 1e9), default=MAX_EVALUE, metavar="E",
+                        help="leave out hits of a larger E-value, unless their TM-score is 0.5 or more "
                         "(default %(default)s)")
-    parser.add_argument("--aligned", type=bounded(int, 1, 100000), default=15, metavar="A",
-                        help="of those, the best that are aligned in full (default %(default)s)")
     parser.add_argument("--json", action="store_true", help="print a JSON object instead of the table")
 
 
@@ -109,7 +122,7 @@ def run_search(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     ca = np.concatenate([s.ca for s in segments])
     try:
-        hits = search(index, ca, "".join(s.sequence for s in segments), args.top, args.candidates, args.aligned)
+        hits = search(index, ca, "".join(s.sequence for s in segments), args.top, args.aligned, args.max_evalue)
     except ValueError as error:  # a chain of the index found damaged as it is read
         raise InputError(f"{args.index}: {error}") from None
     seconds = time.perf_counter() - start
@@ -117,32 +130,46 @@ def run_search(args: argparse.Namespace) -> int:
         "query": f"{path} chain {chain}",
         "query_length": len(ca),
         "searched": len(index),
-        "screened": min(max(args.candidates, args.aligned, args.top), len(index)),
-        "aligned": min(max(args.aligned, args.top), len(index)),
+        "scored": min(len(index), SCORED),
+        "aligned": min(args.aligned, len(index)),
+        "max_evalue": args.max_evalue,
         "seconds": round(seconds, 3),
-        "hits": [
-            {"entry": h.entry, "chain": h.chain, "path": h.path, "length": h.length,
-             "tm_score": round(h.match.tm_score_a, 4), "tm_score_hit": round(h.match.tm_score_b, 4),
-             "n_aligned": h.match.n_aligned, "rms": round(h.match.rms_aligned, 3),
-             "identity": round(h.match.identity, 4), "descriptor_distance": round(h.descriptor_distance, 3)}
-            for h in hits
-        ],
+        "hits": [_hit(hit) for hit in hits],
     }
     print(json.dumps(report, indent=2) if args.json else _table(report))
     return 0
 
 
+def _hit(hit: Hit) -> dict:
+    found = {"entry": hit.entry, "chain": hit.chain, "path": hit.path, "length": hit.length,
+             "evalue": float(f"{hit.evalue:.3g}"), "bits": round(hit.score / 2, 1)}
+    match = hit.match
+    return found | {
+        "tm_score": None if match is None else round(match.tm_score_a, 4),
+        "tm_score_hit": None if match is None else round(match.tm_score_b, 4),
+        "n_aligned": None if match is None else match.n_aligned,
+        "rms": None if match is None else round(match.rms_aligned, 3),
+        "identity": None if match is None else round(match.identity, 4),
+        "fold_score": None if hit.fold_score is None else round(hit.fold_score, 4),
+    }
+
+
 def _table(report: dict) -> str:
     lines = [f"{report['query']} ({report['query_length']} residues) against {report['searched']} chains: "
-             f"{report['screened']} nearest by descriptor screened, {report['aligned']} aligned in "
-             f"{report['seconds']:.2f} s",
-             "TM-score normalised by the query (and by the hit); below 0.5 the folds differ",
-             f"{'rank':>4}  {'entry':<12} {'chain':<6}{'length':>7}{'TM-score':>10}{'(hit)':>8}{'aligned':>9}"
-             f"{'rms Å':>8}{'identity':>10}{'descr. Å':>10}"]
+             f"{report['scored']} scored by the alignment of 3Di states and amino acids, the best "
+             f"{report['aligned']} aligned by structure, in {report['seconds']:.2f} s; "
+             f"{len(report['hits'])} hits of E-value {report['max_evalue']:g} or less or TM-score 0.5 or more",
+             "TM-score normalised by the query (and by the hit); below 0.5 the folds differ; E-value: the unrelated "
+             "chains expected to score as high",
+             f"{'rank':>4}  {'entry':<12} {'chain':<6}{'length':>7}{'E-value':>10}{'bits':>7}{'TM-score':>10}"
+             f"{'(hit)':>8}{'aligned':>9}{'rms Å':>8}{'identity':>10}"]
     for rank, hit in enumerate(report["hits"], 1):
-        lines.append(f"{rank:>4}  {hit['entry']:<12} {hit['chain']:<6}{hit['length']:>7}{hit['tm_score']:>10.4f}"
-                     f"{hit['tm_score_hit']:>8.4f}{hit['n_aligned']:>9}{hit['rms']:>8.2f}"
-                     f"{100 * hit['identity']:>9.1f}%{hit['descriptor_distance']:>10.2f}")
+        line = (f"{rank:>4}  {hit['entry']:<12} {hit['chain']:<6}{hit['length']:>7}{hit['evalue']:>10.2g}"
+                f"{hit['bits']:>7.1f}")
+        if hit["tm_score"] is not None:
+            line += (f"{hit['tm_score']:>10.4f}{hit['tm_score_hit']:>8.4f}{hit['n_aligned']:>9}{hit['rms']:>8.2f}"
+                     f"{100 * hit['identity']:>9.1f}%")
+        lines.append(line)
     return "\n".join(lines)
 
 

@@ -168,19 +168,21 @@ def _pairs_and_alignment(chain_a: Sequence[BackboneSegment], chain_b: Sequence[B
 
 
 def fold_match(ca_a: np.ndarray, ca_b: np.ndarray, pairs_a: np.ndarray, pairs_b: np.ndarray,
-               names_a: np.ndarray, names_b: np.ndarray) -> FoldMatch:
+               names_a: np.ndarray, names_b: np.ndarray, step: int = 1) -> FoldMatch:
     """TM-align's summary of paired Cα (3 pairs or more): the pairs within ``tm_d8`` of the
     shorter chain after the TM-score superposition, their TM-score normalised by either
-    chain, rms and sequence identity (``names_*``: residue names of each chain)."""
+    chain, rms and sequence identity (``names_*``: residue names of each chain). ``step``:
+    the TM-score searches start from fragments at every ``step``-th pair (1: TM-align's final
+    search; larger is quicker)."""
     length_a, length_b = len(ca_a), len(ca_b)
-    motion, _ = tm_superpose(ca_a[pairs_a], ca_b[pairs_b], length_a)
+    motion, _ = tm_superpose(ca_a[pairs_a], ca_b[pairs_b], length_a, step)
     distance = np.linalg.norm(ca_a[pairs_a] - motion.apply(ca_b[pairs_b]), axis=1)
     close = distance < tm_d8(min(length_a, length_b))
     if close.sum() < MIN_PAIRS:
         close = np.argsort(distance)[:MIN_PAIRS]
     a, b = pairs_a[close], pairs_b[close]
-    motion_a, score_a = tm_superpose(ca_a[a], ca_b[b], length_a)
-    _, score_b = tm_superpose(ca_a[a], ca_b[b], length_b)
+    motion_a, score_a = tm_superpose(ca_a[a], ca_b[b], length_a, step)
+    _, score_b = tm_superpose(ca_a[a], ca_b[b], length_b, step)
     rms = float(np.sqrt(np.mean(np.sum((ca_a[a] - motion_a.apply(ca_b[b])) ** 2, axis=1))))
     return FoldMatch(score_a, score_b, len(a), rms, float(np.mean(names_a[a] == names_b[b])))
 

@@ -127,6 +127,21 @@ def align_folds(
     return FoldAlignment(pairs_a, pairs_b, motion, score)
 
 
+def refine_pairs(ca_a: np.ndarray, ca_b: np.ndarray, pairs_a: np.ndarray, pairs_b: np.ndarray, rounds: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """TM-align's refinement of one alignment of two chains' Cα (k >= 3 pairs, increasing
+    indices into each): the superposition of its pairs, then ``rounds`` rounds of dynamic
+    programming on the TM-score terms and the superposition again
+    (:func:`core.analysis.tm_align.refine`), a small part of :func:`align_folds`' work.
+    Returns the increasing pairs of the best alignment found."""
+    given = np.full(len(ca_b), -1, dtype=np.int64)
+    given[np.asarray(pairs_b, dtype=np.int64)] = np.asarray(pairs_a, dtype=np.int64)
+    invmap, _ = tm_align.refine(np.ascontiguousarray(ca_a, dtype=np.float64),
+                                np.ascontiguousarray(ca_b, dtype=np.float64), given, int(rounds))
+    pairs_b = np.flatnonzero(invmap >= 0)
+    return invmap[pairs_b], pairs_b
+
+
 def align_structures(
     ca_a: np.ndarray, ca_b: np.ndarray, pairs_a: np.ndarray | None = None, pairs_b: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:

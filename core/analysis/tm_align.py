@@ -756,34 +756,23 @@ def align(x: np.ndarray, y: np.ndarray, given: np.ndarray) -> tuple[np.ndarray, 
 
 
 @njit(cache=True)
-def screen(query: np.ndarray, coordinates: np.ndarray, starts: np.ndarray, lengths: np.ndarray, step: int
-           ) -> np.ndarray:
-    """Quick TM-scores (normalised by the query) of the query's Cα (n, 3) against the chains
-    of ``coordinates`` (chain k: ``lengths[k]`` rows from ``starts[k]``), each chain taken at
-    every ``step``-th Cα: :func:`align`, then the TM-score search (from fragments
-    :data:`SIMPLIFY_STEP` pairs apart) of its pairs within TM-align's cutoff. 0 for a chain of
-    fewer than 5 Cα so taken."""
-    x = np.ascontiguousarray(query[::step])
-    scores = np.zeros(len(starts))
-    if len(x) < 5:
-        return scores
-    d0 = max(1.24 * max(len(x) - 15.0, 0.0) ** (1.0 / 3.0) - 1.8, 0.5)
-    for k in range(len(starts)):
-        y = np.ascontiguousarray(coordinates[starts[k]:starts[k] + lengths[k]:step])
-        if len(y) < 5:
-            continue
-        invmap, _, rotation, translation = align(x, y, np.full(len(y), -1, dtype=np.int64))
-        cut = 1.5 * min(len(x), len(y)) ** 0.3 + 3.5
-        close = np.full(len(y), -1, dtype=np.int64)
-        moved = np.empty((len(x), 3))
-        _moved(x, rotation, translation, moved)
-        for j in range(len(y)):
-            if invmap[j] >= 0 and _squared(moved, y, invmap[j], j) <= cut * cut:
-                close[j] = invmap[j]
-        if np.sum(close >= 0) < 3:
-            close = invmap
-        scores[k] = _detailed_search(x, y, close, SIMPLIFY_STEP, d0, min(max(d0, 4.5), 8.0), np.inf, len(x))[0]
-    return scores
+def refine(x: np.ndarray, y: np.ndarray, given: np.ndarray, rounds: int) -> tuple[np.ndarray, float]:
+    """TM-align's refinement of one pairing ``given`` (m,) of chains x and y alone (no other
+    start): TM-score's search of its pairs, then ``rounds`` rounds of :func:`_dp_iterations`.
+    Returns the best pairing (``invmap``) and its TM-score in the search (as :func:`align`)."""
+    shorter = min(len(x), len(y))
+    d0 = (0.168 if shorter <= 19 else 1.24 * (shorter - 15.0) ** (1.0 / 3.0) - 1.8) + 0.8
+    d0_search = min(max(d0, 4.5), 8.0)
+    cut = 1.5 * shorter**0.3 + 3.5
+    best_map = given.copy()
+    best, rotation, translation = _detailed_search(x, y, given, SIMPLIFY_STEP, d0, d0_search, cut, shorter)
+    if best < 0.0:
+        return best_map, best
+    found = np.full(len(y), -1, dtype=np.int64)
+    tm = _dp_iterations(x, y, rotation, translation, 0, rounds, d0, d0_search, cut, shorter, found)
+    if tm > best:
+        best, best_map = tm, found
+    return best_map, best
 
 
 @njit(cache=True)

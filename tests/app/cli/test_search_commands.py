@@ -50,7 +50,7 @@ def test_the_index_holds_every_protein_chain_of_20_residues_or_more(index_file):
     assert chains == [("1ACB", "E"), ("1ACB", "I"), ("1BMA", "A"), ("1BPI", "A"), ("1L2Y", "A"), ("1TIM", "A"),
                       ("1TIM", "B"), ("1UBQ", "A"), ("2K39_CA-only", "A"), ("3PTB", "A"), ("3SGB", "E"), ("3SGB", "I")]
     assert index.descriptors.dtype == np.float16 and index.descriptors.shape == (12, 247)
-    assert len(index.coordinates) == index.lengths.sum() == len(index.sequences)
+    assert len(index.coordinates) == index.lengths.sum() == len(index.sequences) == len(index.states)
     with np.load(index_file, allow_pickle=False) as archive:  # plain arrays: no pickled objects
         assert set(archive.files) == set(FIELDS)
 
@@ -59,7 +59,7 @@ def test_search_finds_the_serine_proteases(index_file, capsys):
     status, out, _ = run(capsys, "search", DATA / "3PTB.pdb.gz", index_file, "--json", "--top", "5")
     report = json.loads(out)
     assert status == 0 and report["searched"] == 12 and report["query_length"] == 223
-    assert report["screened"] == report["aligned"] == 12  # at most the index
+    assert report["scored"] == report["aligned"] == 12  # at most the index
     hits = [(h["entry"], h["chain"]) for h in report["hits"]]
     assert hits[0] == ("3PTB", "A") and report["hits"][0]["tm_score"] == pytest.approx(1.0)
     assert set(hits[1:4]) == {("1BMA", "A"), ("1ACB", "E"), ("3SGB", "E")}
@@ -67,7 +67,8 @@ def test_search_finds_the_serine_proteases(index_file, capsys):
     assert by_entry["1BMA"]["tm_score"] == pytest.approx(0.955, abs=0.02)  # TM-align's, by trypsin
     assert by_entry["3SGB"]["tm_score"] == pytest.approx(0.602, abs=0.02)
     assert by_entry["1BMA"]["identity"] > 0.3 > by_entry["3SGB"]["identity"]
-    assert [h["tm_score"] for h in report["hits"]] == sorted((h["tm_score"] for h in report["hits"]), reverse=True)
+    assert [h["fold_score"] for h in report["hits"]] == sorted((h["fold_score"] for h in report["hits"]), reverse=True)
+    assert all(h["evalue"] < 1e-5 for h in report["hits"][:4]) and report["max_evalue"] == 10
 
 
 def test_search_by_chain_as_a_table(index_file, capsys):
@@ -76,7 +77,7 @@ def test_search_by_chain_as_a_table(index_file, capsys):
     assert status == 0 and "chain A (76 residues) against 12 chains" in lines[0]
     assert lines[3].split()[1:3] == ["1UBQ", "A"]
     assert lines[4].split()[1:3] == ["2K39_CA-only", "A"]  # its NMR model next
-    assert float(lines[4].split()[4]) > 0.9
+    assert float(lines[4].split()[4]) < 1e-8 and float(lines[4].split()[6]) > 0.9  # E-value, TM-score
 
 
 def test_an_index_in_worker_processes_and_on_a_dask_cluster_is_the_same(folder, index_file, tmp_path, capsys):
@@ -131,6 +132,7 @@ def test_bad_input(argv, message, tmp_path, capsys):
     ("lengths that disagree", "its arrays disagree"),
     ("a flipped bit in the coordinates", "changed since it was indexed"),
     ("a residue renamed", "changed since it was indexed"),
+    ("a 3Di state changed", "changed since it was indexed"),
 ])
 def test_a_damaged_index_asks_to_be_built_again(index_file, tmp_path, capsys, damage, message):
     """Each of these gave a traceback (ZeroDivisionError, IndexError, ...); each now says what is
@@ -151,6 +153,8 @@ def test_a_damaged_index_asks_to_be_built_again(index_file, tmp_path, capsys, da
         arrays["coordinates"].view(np.uint32)[::7] ^= 1 << 12
     elif damage == "a residue renamed":
         arrays["sequences"][::5] = b"X"
+    elif damage == "a 3Di state changed":
+        arrays["states"][::5] = (arrays["states"][::5] + 1) % 20
     else:
         arrays["lengths"][0] += 5
     damaged = tmp_path / "damaged.npz"

@@ -1,6 +1,6 @@
-"""Fold descriptors of the low-level curves: invariant to position and orientation, near for one
-fold and far for others; the screen of the candidates against the full alignment; the index
-file round trip and what it refuses."""
+"""Fold search: the local alignment of 3Di states and amino acids and its E-values, the hits aligned
+by structure; the descriptors of the low-level curves (invariant to position and orientation, near
+for one fold and far for others); the index file round trip and what it refuses."""
 
 from pathlib import Path
 
@@ -14,12 +14,13 @@ from core.analysis.fold_search import (
     FoldIndex,
     curve_descriptor,
     descriptor_distances,
+    evalues,
     index_path,
     merge,
     search,
     sensitivity,
 )
-from core.analysis.tm_align import screen
+from core.analysis.local_alignment import local_pairs, local_scores
 from core.curves.wavelets import smooth
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -52,33 +53,62 @@ def test_one_fold_is_near_and_others_far(index) -> None:
     assert distance[rows["1BMA"]] < min(distance[rows["1UBQ"]], distance[rows["1TIM"]])  # elastase, a protease
 
 
-def test_search_orders_the_candidates_by_tm_score(index) -> None:
-    """Every chain screened by the alignment of every 4th Cα, the best 3 aligned in full: the
-    screen keeps elastase's own chain and trypsin."""
-    ca, codes = index.chain(int(np.flatnonzero(index.entries == "1BMA")[0]))
-    hits = search(index, ca, codes.tobytes().decode(), top=3, candidates=len(index), aligned=3)
-    assert [h.entry for h in hits[:2]] == ["1BMA", "3PTB"] and hits[0].match.tm_score_a == pytest.approx(1.0)
-    assert hits[0].match.tm_score_a >= hits[1].match.tm_score_a >= hits[2].match.tm_score_a
+def test_search_ranks_the_proteases_by_their_alignment_and_fold_score(index) -> None:
+    """Elastase finds itself, then trypsin (a serine protease of another sequence), with
+    E-values far below ubiquitin's and the TIM barrel's; the aligned hits come by fold score,
+    and trypsin's TM-score is within 0.03 of TM-align's full search."""
+    row = int(np.flatnonzero(index.entries == "1BMA")[0])
+    ca, codes = index.chain(row)
+    hits = search(index, ca, codes.tobytes().decode(), top=len(index), max_evalue=np.inf)
+    assert [h.entry for h in hits[:2]] == ["1BMA", "3PTB"] and len(hits) == len(index)
+    assert hits[0].match.tm_score_a == pytest.approx(1.0) and hits[0].evalue < 1e-40
+    by_entry = {h.entry: h for h in hits}
+    assert by_entry["3PTB"].evalue < 1e-10 < min(by_entry[e].evalue for e in ("1UBQ", "1TIM"))
+    trypsin = index.chain(by_entry["3PTB"].row)[0]
+    assert by_entry["3PTB"].match.tm_score_a == pytest.approx(align_folds(ca, trypsin).tm_score, abs=0.03)
+    folds = [h.fold_score for h in hits if h.fold_score is not None]
+    assert folds == sorted(folds, reverse=True) and len(folds) == len(index)  # every chain aligned here
+    assert [h.entry for h in search(index, ca, codes.tobytes().decode(), top=3, aligned=2)][:2] == ["1BMA", "3PTB"]
 
 
-def test_the_screen_scores_as_the_alignment_does(index) -> None:
-    """On every Cα, the screen's TM-score is the full alignment's (to its quicker final search);
-    on every 4th, trypsin and elastase still rank first for elastase, ubiquitin last."""
-    ca, _ = index.chain(int(np.flatnonzero(index.entries == "1BMA")[0]))
-    full = np.array([align_folds(ca, index.chain(k)[0]).tm_score for k in range(len(index))])
-    assert screen(ca, index.coordinates, index.starts, index.lengths, 1) == pytest.approx(full, abs=0.01)
-    quick = screen(ca, index.coordinates, index.starts, index.lengths, 4)
-    order = index.entries[np.argsort(-quick)].tolist()
-    assert order[:2] == ["1BMA", "3PTB"] and set(order[-2:]) == {"1UBQ", "2K39_CA-only"}
+def test_search_leaves_out_what_is_neither_significant_nor_of_the_fold(index) -> None:
+    """In an index of 6 chains any unrelated chain scores as well as 2 or more others would (an
+    E-value of 2 to 4); ubiquitin's NMR model (Cα only) is significant at 1e-11."""
+    ca, codes = index.chain(int(np.flatnonzero(index.entries == "1UBQ")[0]))
+    hits = search(index, ca, codes.tobytes().decode(), max_evalue=1e-3)
+    assert [h.entry for h in hits] == ["1UBQ", "2K39_CA-only"] and hits[1].evalue < 1e-8
+    others = search(index, ca, codes.tobytes().decode())[2:]
+    assert len(others) == 4 and all(1 < h.evalue <= 10 and h.match.tm_score_a < 0.4 for h in others)
+    assert len(search(index, ca, codes.tobytes().decode(), top=1)) == 1
+
+
+def test_local_alignment_scores_and_pairs_agree_and_evalues_fall_with_score() -> None:
+    """The linear-memory scores are the best of the full table's, on any chain; the pairs the
+    traceback gives sum, with their gaps, to that score; a higher score is less expected."""
+    rng = np.random.default_rng(5)
+    profile = rng.normal(-1.0, 3.0, size=(40, 420)).astype(np.float32)
+    chains = [rng.integers(0, 420, size=n).astype(np.int16) for n in (1, 7, 40, 93)]
+    codes = np.concatenate(chains)
+    starts = np.concatenate([[0], np.cumsum([len(c) for c in chains])[:-1]]).astype(np.int64)
+    scores = local_scores(profile, codes, starts, np.array([len(c) for c in chains]), 10.0, 1.0)
+    for chain, score in zip(chains, scores):
+        pairs_a, pairs_b, best = local_pairs(profile, chain, 10.0, 1.0)
+        assert best == pytest.approx(score, rel=1e-6)
+        total = profile[pairs_a, chain[pairs_b]].sum()
+        for gaps in (np.diff(pairs_a) - 1, np.diff(pairs_b) - 1):
+            total -= np.sum(np.where(gaps > 0, 10.0 + (gaps - 1) * 1.0, 0.0))
+        assert total == pytest.approx(best, rel=1e-5) and (np.diff(pairs_a) > 0).all() and (np.diff(pairs_b) > 0).all()
+    low, high = evalues(np.array([50.0, 150.0]), 100, np.array([120, 120]), 1000)
+    assert 0 < high < low <= 1000
 
 
 def test_the_index_file_round_trip_and_refusals(index, tmp_path) -> None:
     path = tmp_path / "folds.npz"
     path.write_bytes(index.to_bytes())
     again = FoldIndex.read(path)
-    for name in ("entries", "chains", "lengths", "descriptors", "coordinates", "sequences"):
+    for name in ("entries", "chains", "lengths", "descriptors", "coordinates", "sequences", "states"):
         assert np.array_equal(getattr(again, name), getattr(index, name))
-    assert isinstance(again.coordinates, np.memmap) and isinstance(again.sequences, np.memmap)  # read per chain
+    assert all(isinstance(getattr(again, name), np.memmap) for name in ("coordinates", "sequences", "states"))
     ca, codes = index.chain(3)
     assert [(h.row, h.match.tm_score_a) for h in search(again, ca, codes.tobytes().decode(), top=3)] == [
         (h.row, h.match.tm_score_a) for h in search(index, ca, codes.tobytes().decode(), top=3)]
