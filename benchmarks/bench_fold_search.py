@@ -1,7 +1,8 @@
 """Fold search measured as the field measures it: Foldseek's sensitivity up to the first false
 positive on a labelled SCOP set, beside exhaustive TM-align, and the cost of a query.
 
-Usage: ``python benchmarks/bench_fold_search.py --scop FOLDER [--tm-align N] [--decoys FOLDER]``.
+Usage: ``python benchmarks/bench_fold_search.py --scop FOLDER [--tm-align N] [--decoys FOLDER]``,
+or ``... --pdb-scale N --base FOLDER --scratch DIR``.
 
 ``FOLDER`` is laid out as the shared ``scop40-dev`` (``labels.tsv``, ``queries.txt``,
 ``domains/``). Every domain is indexed (as ``ribbonwave index`` does); for each query, every
@@ -13,7 +14,11 @@ averaged over the queries. One line per method, with the CPU seconds per query:
   of 3Di states and amino acids of every domain, the best aligned by structure), its whole
   ranking (every domain, whatever its E-value);
 - its first stage alone, the ranking by local alignment score;
-- the curve descriptors alone (the screen of indexes larger than ``fold_search.SCORED``);
+- the curve descriptors alone;
+- the screen of indexes larger than ``fold_search.SCORED`` chains (the nearest by descriptor
+  and by pair profile, half each) at the scale of the PDB: per query and level, the share of
+  the true positives that rank within the first ``SCORED / 2`` of 800,000 by either (fewer
+  domains of other folds ahead of them than that fraction of those here), averaged;
 - exhaustive TM-align (``tmtools``, TM-score normalised by the query), on the first ``N``
   queries only (about a minute each on 556 domains), and ``search`` on the same queries.
 
@@ -22,12 +27,23 @@ averaged over the queries. One line per method, with the CPU seconds per query:
 another fold unless exhaustive TM-align finds it of the query's fold (TM-score by the query
 0.5 or more: a sialidase among the decoys is a true match of a sialidase domain); such decoys
 are set aside, and counted.
+
+``--pdb-scale N``: the cost at the size of the PDB. An index of ``N`` chains (800,000: the
+PDB's protein chains) is written to ``DIR``: the chains of the structures in ``--base``
+repeated, each copy perturbed (descriptors by 0.2 Å of noise, pair profiles by 0.05, a tenth of its 3Di states and a
+third of its amino acids replaced at random; its Cα kept, so that the copies of a chain align
+as it does). A fresh process then reads it and searches 20 of the base chains; it prints the
+file's size, the resident memory after reading and at its peak, and the CPU and wall time of
+a query.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -38,17 +54,23 @@ import tmtools
 from app.cli.batch import structure_paths
 from core.analysis.compare import SAME_FOLD
 from core.analysis.fold_search import (
+    FIELDS,
+    FORMAT,
+    SCORED,
     FoldIndex,
     alignment_scores,
+    checksum,
     descriptor_distances,
     index_path,
     merge,
+    profile_similarities,
     query_profile,
     search,
     sensitivity,
 )
 
 LEVELS = ("family", "superfamily", "fold")
+PDB_CHAINS = 800_000
 
 
 def build_index(paths: list[Path]) -> tuple[FoldIndex, float]:
@@ -72,6 +94,27 @@ def measure(name: str, rank: Callable[[int], np.ndarray], queries: list[int], la
     found = np.array([score for score in scores if score is not None])
     print(f"{name:<52}{len(found):>8}" + "".join(f"{value:>{width}.3f}" for value, width in
                                                   zip(found.mean(axis=0), (8, 10, 7), strict=True))
+          + f"{np.mean(cpu):>13.3f}", flush=True)
+
+
+def screen_kept(index: FoldIndex, queries: list[int], labels: dict[str, np.ndarray]) -> None:
+    share = SCORED / 2 / PDB_CHAINS
+    kept, cpu = [], []
+    for row in queries:
+        start = time.process_time()
+        nearness = (-descriptor_distances(index.descriptors, index.descriptors[row]),
+                    profile_similarities(index.profiles, index.profiles[row].astype(np.float32)))
+        cpu.append(time.process_time() - start)
+        kinds = np.select([labels[level] == labels[level][row] for level in LEVELS], [0, 1, 2], 3)
+        kinds[row] = -1
+        other = kinds == 3
+        ahead = [np.array([np.mean(score[other] >= score[k]) for k in range(len(kinds))]) for score in nearness]
+        survives = (ahead[0] <= share) | (ahead[1] <= share)
+        totals = np.bincount(kinds[kinds >= 0], minlength=4)[:3]
+        if totals.all():
+            kept.append(np.bincount(kinds[(kinds >= 0) & survives], minlength=4)[:3] / totals)
+    print(f"{f'screen of > {SCORED:,} chains: kept at {PDB_CHAINS:,}':<52}{len(kept):>8}"
+          + "".join(f"{value:>{width}.3f}" for value, width in zip(np.mean(kept, axis=0), (8, 10, 7), strict=True))
           + f"{np.mean(cpu):>13.3f}", flush=True)
 
 
@@ -100,6 +143,7 @@ def scop_sensitivity(folder: Path, tm_align_queries: int, decoys: Path | None) -
     measure("its local alignment of 3Di + amino acids alone", scored, queries, labels)
     measure("curve descriptors alone", lambda row: np.argsort(
         descriptor_distances(index.descriptors, index.descriptors[row]), kind="stable"), queries, labels)
+    screen_kept(index, queries, labels)
     if tm_align_queries:
         asked = queries[:tm_align_queries]
         measure(f"search on the first {len(asked)} queries", searched, asked, labels)
@@ -130,16 +174,99 @@ def scop_sensitivity(folder: Path, tm_align_queries: int, decoys: Path | None) -
               f"({np.mean(set_aside):.1f} a query; the CPU above includes these TM-align runs)")
 
 
+def pdb_scale(chains: int, base: Path, scratch: Path, keep: bool = False) -> None:
+    index, _ = build_index(structure_paths([base]))
+    rng = np.random.default_rng(1)
+    copies = rng.integers(0, len(index), chains)
+    copies[:len(index)] = np.arange(len(index))  # every base chain once, unchanged, first
+    lengths = index.lengths[copies]
+    residues = np.concatenate([np.arange(index.starts[k], index.starts[k] + index.lengths[k]) for k in copies])
+    states = index.states[residues]
+    changed = rng.random(len(states)) < 0.1
+    changed[:index.lengths.sum()] = False
+    states[changed] = rng.integers(0, 20, changed.sum())
+    sequences = index.sequences[residues]
+    changed = rng.random(len(sequences)) < 1 / 3
+    changed[:index.lengths.sum()] = False
+    sequences[changed] = np.frombuffer(b"ACDEFGHIKLMNPQRSTVWY", dtype="S1")[rng.integers(0, 20, changed.sum())]
+    coordinates = index.coordinates[residues]
+    descriptors = (index.descriptors[copies].astype(np.float32)
+                   + rng.normal(0.0, 0.2, (chains, index.descriptors.shape[1])).astype(np.float32)).astype(np.float16)
+    starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+    sums = np.array([checksum(coordinates[a:a + n], sequences[a:a + n], states[a:a + n])
+                     for a, n in zip(starts.tolist(), lengths.tolist())], dtype=np.uint32)
+    path = scratch / f"pdb-scale-{chains}.npz"
+    profiles = (index.profiles[copies].astype(np.float32)
+                + rng.normal(0.0, 0.05, (chains, index.profiles.shape[1])).astype(np.float32)).astype(np.float16)
+    arrays = {"entries": index.entries[copies], "chains": index.chains[copies], "paths": index.paths[copies],
+              "lengths": lengths, "descriptors": descriptors, "profiles": profiles, "checksums": sums,
+              "coordinates": coordinates, "sequences": sequences, "states": states}
+    assert set(arrays) == set(FIELDS[1:])
+    np.savez(path, format=np.array(FORMAT), **arrays)
+    del arrays, coordinates, sequences, states, descriptors, profiles
+    print(f"{chains:,} chains ({len(index)} of {base} repeated), {lengths.sum() / 1e6:.0f} million residues: "
+          f"{path.stat().st_size / 1e9:.2f} GB on disk")
+    queries = np.linspace(0, len(index) - 1, 20).round().astype(int).tolist()
+    found = json.loads(subprocess.run([sys.executable, __file__, "--measure", str(path), *map(str, queries)],
+                                      check=True, capture_output=True, text=True).stdout)
+    print(f"read in {found['read_s']:.2f} s; resident {found['resident_mb']:.0f} MB after reading, "
+          f"{found['peak_mb']:.0f} MB at the peak of {len(queries)} searches (the process, Python and its libraries "
+          f"included: {found['empty_mb']:.0f} MB before reading)")
+    print(f"a query: {np.mean(found['cpu']):.2f} s CPU (at most {np.max(found['cpu']):.2f}), "
+          f"{np.mean(found['wall']):.2f} s wall; the query's own chain first in "
+          f"{sum(found['self_first'])} of {len(queries)}")
+    if not keep:
+        path.unlink()
+
+
+def measure_scale(path: Path, queries: list[int]) -> None:
+    """In a fresh process: read the index and search it; print a JSON object of the figures."""
+    def resident(field: str = "VmRSS") -> float:  # VmHWM: the peak (getrusage's counts the parent's, before exec)
+        with open("/proc/self/status") as status:
+            return next(int(line.split()[1]) for line in status if line.startswith(field)) / 1024
+
+    empty = resident()
+    start = time.perf_counter()
+    index = FoldIndex.read(path)
+    read = time.perf_counter() - start
+    after = resident()
+    cpu, wall, first = [], [], []
+    search(index, *chain(index, queries[0]))  # loads the compiled kernels
+    for row in queries:
+        query = chain(index, row)
+        start, clock = time.perf_counter(), time.process_time()
+        hits = search(index, *query)
+        cpu.append(time.process_time() - clock)
+        wall.append(time.perf_counter() - start)
+        first.append(bool(hits) and hits[0].row == row)
+    print(json.dumps({"read_s": read, "empty_mb": empty, "resident_mb": after, "cpu": cpu, "wall": wall,
+                      "peak_mb": resident("VmHWM"), "self_first": first}))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scop", type=Path, metavar="FOLDER", required=True,
+    parser.add_argument("--scop", type=Path, metavar="FOLDER",
                         help="a labelled SCOP set (labels.tsv, queries.txt, domains/)")
     parser.add_argument("--tm-align", type=int, default=0, metavar="N",
                         help="also rank the first N queries by exhaustive TM-align (slow: about a minute each)")
     parser.add_argument("--decoys", type=Path, metavar="FOLDER", help="structures whose chains pad the index")
+    parser.add_argument("--pdb-scale", type=int, metavar="N", help="time a query against an index of N chains")
+    parser.add_argument("--base", type=Path, metavar="FOLDER", help="--pdb-scale: the structures to repeat")
+    parser.add_argument("--scratch", type=Path, metavar="DIR", help="--pdb-scale: where to write the index")
+    parser.add_argument("--measure", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.measure:
+        measure_scale(Path(args.measure[0]), [int(row) for row in args.measure[1:]])
+        return
     print(f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())} on {os.cpu_count()} cores")
-    scop_sensitivity(args.scop, args.tm_align, args.decoys)
+    if args.pdb_scale:
+        if args.base is None or args.scratch is None:
+            parser.error("--pdb-scale needs --base and --scratch")
+        pdb_scale(args.pdb_scale, args.base, args.scratch)
+    elif args.scop is not None:
+        scop_sensitivity(args.scop, args.tm_align, args.decoys)
+    else:
+        parser.error("give --scop FOLDER or --pdb-scale N")
 
 
 if __name__ == "__main__":

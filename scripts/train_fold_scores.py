@@ -16,6 +16,10 @@ paste into :mod:`core.analysis.structural_alphabet` and :mod:`core.analysis.fold
 3. ``SCORE_SLOPE``, ``SCORE_LOCATION``, ``SCORE_SCALE``: the local alignment scores (with the
    search's scoring) of every other pair of chains of different entries, unrelated nearly all,
    fitted as ``slope ln(m n)`` plus a Gumbel variable (location, scale): the search's E-values.
+
+It writes ``core/analysis/state_pairs.npz`` (first, as the index needs it): the pair profile's
+weights (the inverse document frequency of each of the 400 pairs of 3Di states over the
+chains), mean and its :data:`~core.analysis.fold_search.PROFILE_SIZE` principal axes.
 """
 
 from __future__ import annotations
@@ -30,6 +34,8 @@ from scipy import stats
 from app.cli.batch import structure_paths
 from core.analysis.fold_alignment import align_folds
 from core.analysis.fold_search import (
+    PAIR_BASIS,
+    PROFILE_SIZE,
     FoldIndex,
     alignment_scores,
     descriptor_distances,
@@ -139,6 +145,22 @@ def calibrate(index: FoldIndex, related: set, matrix: np.ndarray) -> tuple[float
     return float(slope), float(location), float(scale)
 
 
+def pair_basis(runs: list[np.ndarray]) -> None:
+    counts = []
+    for run in runs:
+        if len(run) >= 20:
+            chain = states(run[:, 1]).astype(np.int64)
+            counts.append(np.bincount(chain[:-1] * 20 + chain[1:], minlength=400))
+    counts = np.array(counts, dtype=np.float64)
+    weights = np.log(len(counts) / (1.0 + np.count_nonzero(counts, axis=0)))
+    vectors = np.sqrt(counts) * weights
+    mean = vectors.mean(axis=0)
+    axes = np.linalg.svd(vectors - mean, full_matrices=False)[2][:PROFILE_SIZE].T
+    np.savez(PAIR_BASIS, weights=weights.astype(np.float32), mean=mean.astype(np.float32),
+             axes=axes.astype(np.float32))
+    print(f"# wrote {PAIR_BASIS.name}: {len(counts)} chains")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("folder", type=Path)
@@ -150,6 +172,7 @@ def main() -> None:
     print(f"N_OFFSETS = np.array({np.round(n_offsets, 4).tolist()})")
     print(f"CB_OFFSETS = np.array({np.round(cb_offsets, 4).tolist()})")
     print(f"# 3Di from Cα alone as from the full backbone: {agreement(runs):.3f} of the residues")
+    pair_basis(runs)
     index = merge([found for found in map(index_path, paths) if isinstance(found, FoldIndex) and len(found)])
     pairs, seen = similar_pairs(index, args.neighbours)
     print(f"# {len(pairs)} similar pairs of {len(seen)} aligned, {sum(len(a) for a, _ in pairs)} residue pairs")

@@ -29,6 +29,7 @@ from core.analysis.fold_search import (
     DESCRIPTOR_SIZE,
     MAX_EVALUE,
     MIN_RESIDUES,
+    PROFILE_SIZE,
     SCORED,
     TOP,
     FoldIndex,
@@ -82,7 +83,7 @@ def run_index(args: argparse.Namespace) -> int:
         raise InputError(f"{output}: cannot write ({error.strerror or error})") from None
     print(f"indexed {len(index)} chains of {len(found)} file(s) in {time.perf_counter() - start:.1f} s"
           + (f"; skipped {len(skipped)} file(s)" if skipped else ""))
-    print(f"wrote {output} ({len(data) / 1e6:.2f} MB; {2 * DESCRIPTOR_SIZE} bytes a chain and 14 a residue)")
+    print(f"wrote {output} ({len(data) / 1e6:.2f} MB; {2 * (DESCRIPTOR_SIZE + PROFILE_SIZE)} bytes a chain and 14 a residue)")
     return 0
 
 

@@ -7,44 +7,45 @@ and amino acids, scored against the query's by local alignment, the best aligned
    of each residue (its backbone's geometry and that of its nearest residue in space) and its
    amino acid. The Smith–Waterman score of the query against every chain
    (:func:`alignment_scores`, :mod:`core.analysis.local_alignment`: 3Di substitution scores
-   plus :data:`AMINO_ACID_WEIGHT` times BLOSUM62, affine gaps) ranks the database at about
-   20 million cells a second a core, and gives each chain an E-value (:func:`evalues`).
+   plus :data:`AMINO_ACID_WEIGHT` times BLOSUM62, affine gaps) ranks the database, about 340
+   million cells a CPU second, and gives each chain an E-value (:func:`evalues`).
 2. The :data:`ALIGNED` best are aligned by structure: their local alignment, refined by two
    rounds of TM-align's dynamic programming on the superposed chains (:func:`refine_pairs`),
    gives the TM-score, rms and identity of each (:class:`~core.analysis.compare.FoldMatch`).
    They come first, by their fold score, the TM-score plus :data:`SCORE_SHARE` times the
    alignment score relative to the query's with itself; the others follow by score.
 
-On SCOP40 (Foldseek's benchmark, ``benchmarks/bench_fold_search.py``) this finds as many
-families and superfamilies as exhaustive TM-align, and folds nearly as many, at about 1/100 of
-its CPU on a thousand domains: the cost of a query grows with the database only by its first
-step.
+On SCOP40's development half (Foldseek's benchmark, ``benchmarks/bench_fold_search.py``) this
+finds as many superfamilies and folds as exhaustive TM-align, and nearly all its families, at
+1/150 of its CPU: the cost of a query grows with the database only by its first step.
 
-Carson's coarse curves describe each chain too (:func:`curve_descriptor`): the distances
-between the control points of its curves of levels 2, 3 and 4 (4, 8 and 16 segments), 247
-numbers that do not change with position or orientation, compared in one vectorised pass
-(:func:`descriptor_distances`). An index of more than :data:`SCORED` chains scores only the
-:data:`SCORED` of nearest descriptor by local alignment. A descriptor knows nothing of domains
-or loose ends, so it misses many remote matches (on SCOP40 it finds a fifth of the
-superfamily matches that the local alignment finds).
+An index of more than :data:`SCORED` chains (the PDB has 800,000) scores by local alignment
+only the :data:`SCORED` / 2 nearest the query by each of two small summaries of a chain, read
+whole in one vectorised pass: Carson's coarse curves (:func:`curve_descriptor`, the distances
+between the control points of its curves of levels 2, 3 and 4, 247 numbers that do not change
+with position or orientation) and the profile of its pairs of consecutive 3Di states
+(:func:`pair_profile`, 32 numbers). Together they keep about 80% of the family matches, 55%
+of the superfamily and 33% of the fold matches of SCOP40 at that scale; neither knows domains.
 
 :func:`index_path` is the unit of parallel work (a top-level function of a path that never
 raises for a bad file); :class:`FoldIndex` holds the chains of many files: their descriptors,
-Cα, sequences and states, saved as an uncompressed ``.npz`` archive of plain arrays (read back
-without pickle; the per-residue arrays, 14 bytes a residue, mapped from the file).
+pair profiles, Cα, sequences and states, saved as an uncompressed ``.npz`` archive of plain arrays (read back
+without pickle; the names and the per-residue arrays, 14 bytes a residue, read as they are used).
 """
 
 from __future__ import annotations
 
 import io
+import os
 import zipfile
 import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cache, cached_property
 from pathlib import Path
 
 import numpy as np
+from numba import njit, prange
 from scipy.spatial.distance import pdist
 
 from core.analysis.compare import SAME_FOLD, FoldMatch, fold_match
@@ -68,23 +69,28 @@ LEVEL_WEIGHTS = np.concatenate([np.full(size, 1.0 / (size * len(LEVEL_SIZES)), d
                                 for size in LEVEL_SIZES])
 """Each distance's weight in :func:`descriptor_distances`: each level counts alike."""
 RANK_BLOCK = 8192
-"""Index rows ranked at once."""
+"""Index rows compared with the query's profile at once."""
 MIN_RESIDUES = 20
 """Chains with fewer residues are not indexed (peptides have no fold to search)."""
-FORMAT = 4
+FORMAT = 5
 """Version of the index file (2: uncompressed, the coordinates and sequences mapped; 3: a
-checksum of each chain's coordinates and sequence; 4: 3Di states)."""
-FIELDS = ("format", "entries", "chains", "paths", "lengths", "descriptors", "checksums", "coordinates", "sequences",
-          "states")
+checksum of each chain's coordinates and sequence; 4: 3Di states; 5: profiles of state pairs)."""
+FIELDS = ("format", "entries", "chains", "paths", "lengths", "descriptors", "profiles", "checksums", "coordinates",
+          "sequences", "states")
 AMINO_ACID_WEIGHT = 0.6
 """Weight of the amino acids' BLOSUM62 score beside the 3Di states' in the local alignment."""
 GAP_OPEN, GAP_EXTEND = 10.0, 1.0
 """Cost of a gap's first residue and of each further one in the local alignment, half bits."""
-SCORE_SLOPE, SCORE_LOCATION, SCORE_SCALE = 15.4147, -115.5945, 19.0039
+SCORE_SLOPE, SCORE_LOCATION, SCORE_SCALE = 15.2322, -113.9755, 18.8031
 """The local alignment scores of unrelated chains of m and n residues: ``SCORE_SLOPE ln(m n)``
 plus a Gumbel variable of this location and scale (``scripts/train_fold_scores.py``)."""
 SCORED = 10_000
-"""Chains scored by local alignment: an index of more has its nearest by descriptor scored."""
+"""Chains scored by local alignment: an index of more has its :data:`SCORED` / 2 nearest by
+descriptor and :data:`SCORED` / 2 nearest by pair profile scored."""
+PAIR_BASIS = Path(__file__).with_name("state_pairs.npz")
+"""The weights, mean and principal axes of :func:`pair_profile` (``scripts/train_fold_scores.py``)."""
+PROFILE_SIZE = 32
+"""Numbers in a pair profile."""
 ALIGNED = 30
 """Chains of best local alignment score that :func:`search` aligns by structure."""
 REFINE_ROUNDS = 2
@@ -96,6 +102,9 @@ SCORE_SHARE = 0.7
 the fold score that orders the chains aligned by structure."""
 TOP, MAX_EVALUE = 100, 10.0
 """Hits :func:`search` lists at most, and the E-value above which it leaves a hit out."""
+LOADED = ("lengths", "descriptors", "profiles", "checksums")
+"""The arrays of an index file read into memory; the others (names, paths and the per-residue
+arrays) are read from the file as they are used (:class:`FileArray`)."""
 REBUILD = "index the files again (ribbonwave index FILE... -o DB --overwrite)"
 """What a damaged or empty index asks for."""
 
@@ -114,17 +123,62 @@ def curve_descriptor(ca: np.ndarray) -> np.ndarray:
 
 
 def descriptor_distances(descriptors: np.ndarray, query: np.ndarray) -> np.ndarray:
-    """(n,) the difference of each row of ``descriptors`` (n, DESCRIPTOR_SIZE) from ``query``:
-    the root of the mean, over :data:`LEVELS`, of each level's mean squared distance difference, Å.
-    Computed :data:`RANK_BLOCK` rows at a time, so a float16 index of the whole PDB is ranked
-    without a float32 copy of it."""
+    """(n,) the difference of each row of ``descriptors`` (n, DESCRIPTOR_SIZE; float16 as the
+    index keeps them, or float32) from ``query``: the root of the mean, over :data:`LEVELS`, of
+    each level's mean squared distance difference, Å. float16 rows are read as they are, never
+    copied (0.8 GB as float32 for the PDB)."""
     query = np.asarray(query, dtype=np.float32)
-    distance = np.empty(len(descriptors))
-    for first in range(0, len(descriptors), RANK_BLOCK):
-        difference = np.asarray(descriptors[first:first + RANK_BLOCK], dtype=np.float32) - query
-        np.square(difference, out=difference)
-        distance[first:first + RANK_BLOCK] = difference @ LEVEL_WEIGHTS
-    return np.sqrt(distance)
+    descriptors = np.asarray(descriptors)
+    if descriptors.dtype == np.float16:
+        return np.sqrt(_weighted_squares(descriptors.view(np.uint16), _HALF, query, LEVEL_WEIGHTS))
+    difference = np.asarray(descriptors, dtype=np.float32) - query
+    return np.sqrt(np.square(difference) @ LEVEL_WEIGHTS)
+
+
+_HALF = np.arange(2**16, dtype=np.uint16).view(np.float16).astype(np.float32)
+"""Every float16 by its bits, as float32."""
+
+
+@njit(cache=True, parallel=True)
+def _weighted_squares(bits: np.ndarray, half: np.ndarray, query: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """(n,) the weighted sum of squared differences of each row of float16 values (given by
+    their ``bits``, read through the table ``half``) from ``query``."""
+    out = np.empty(bits.shape[0])
+    for k in prange(bits.shape[0]):
+        total = 0.0
+        for j in range(bits.shape[1]):
+            difference = half[bits[k, j]] - query[j]
+            total += weights[j] * difference * difference
+        out[k] = total
+    return out
+
+
+@cache
+def _pair_basis() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    with np.load(PAIR_BASIS) as basis:
+        return basis["weights"], basis["mean"], basis["axes"]
+
+
+def pair_profile(chain_states: np.ndarray) -> np.ndarray:
+    """(PROFILE_SIZE,) float32 unit vector: which pairs of 3Di states follow each other along a
+    chain (``chain_states``, n >= 2). The square roots of the 400 pairs' counts, weighted by how
+    rare each pair is among chains (its inverse document frequency), less their mean over
+    chains, on their principal axes; all learnt from the shared set."""
+    chain_states = np.asarray(chain_states, dtype=np.int64)
+    counts = np.bincount(chain_states[:-1] * 20 + chain_states[1:], minlength=400).astype(np.float32)
+    weights, mean, axes = _pair_basis()
+    profile = (np.sqrt(counts) * weights - mean) @ axes
+    return (profile / max(float(np.linalg.norm(profile)), 1e-12)).astype(np.float32)
+
+
+def profile_similarities(profiles: np.ndarray, query: np.ndarray) -> np.ndarray:
+    """(n,) the cosine of each row of ``profiles`` (n, PROFILE_SIZE) with ``query``, computed
+    :data:`RANK_BLOCK` rows at a time."""
+    query = np.asarray(query, dtype=np.float32)
+    similarity = np.empty(len(profiles))
+    for first in range(0, len(profiles), RANK_BLOCK):
+        similarity[first:first + RANK_BLOCK] = np.asarray(profiles[first:first + RANK_BLOCK], dtype=np.float32) @ query
+    return similarity
 
 
 @dataclass(frozen=True, eq=False)
@@ -136,6 +190,7 @@ class FoldIndex:
     entries, chains, paths : (n,) str: the entry id, chain id and file of each chain.
     lengths : (n,) int64 residues.
     descriptors : (n, DESCRIPTOR_SIZE) float16 (:func:`curve_descriptor`).
+    profiles : (n, PROFILE_SIZE) float16 (:func:`pair_profile`).
     checksums : (n,) uint32 CRC-32 of each chain's coordinates, sequence and states (:func:`checksum`).
     coordinates : (lengths.sum(), 3) float32 Cα of every chain, one after another, Å.
     sequences : (lengths.sum(),) one-letter residue codes (bytes), in the same order.
@@ -147,6 +202,7 @@ class FoldIndex:
     paths: np.ndarray
     lengths: np.ndarray
     descriptors: np.ndarray
+    profiles: np.ndarray
     checksums: np.ndarray
     coordinates: np.ndarray
     sequences: np.ndarray
@@ -184,14 +240,14 @@ class FoldIndex:
 
     @classmethod
     def read(cls, path: Path) -> FoldIndex:
-        """Read an index written by :meth:`to_bytes`, its coordinates and sequences mapped from
-        the file (read as the chains are used); ValueError when it is not one."""
+        """Read an index written by :meth:`to_bytes`, all but :data:`LOADED` read from the file
+        as they are used (:class:`FileArray`); ValueError when it is not one."""
         try:
             with np.load(path, allow_pickle=False) as archive:
                 if int(archive["format"]) != FORMAT:
                     raise ValueError(f"{path}: a fold index of another format version (index the files again)")
-                arrays = {name: archive[name] for name in FIELDS[1:7]}  # the rest is mapped
-            arrays |= {name: _mapped(path, name) for name in FIELDS[7:]}
+                arrays = {name: archive[name] for name in LOADED}
+            arrays |= {name: FileArray(path, name) for name in FIELDS[1:] if name not in LOADED}
         except (OSError, KeyError, EOFError, zipfile.BadZipFile) as error:
             raise ValueError(f"{path}: not a ribbonwave fold index ({type(error).__name__}: {error})") from None
         except ValueError as error:
@@ -203,36 +259,70 @@ class FoldIndex:
         if not n:
             raise ValueError(f"{path}: a fold index of no chain; {REBUILD}")
         residues = int(index.lengths.sum())
-        if (index.descriptors.shape != (n, DESCRIPTOR_SIZE) or len(index.lengths) != n or len(index.chains) != n
+        if (index.descriptors.shape != (n, DESCRIPTOR_SIZE) or index.profiles.shape != (n, PROFILE_SIZE)
+                or len(index.lengths) != n or len(index.chains) != n
                 or index.checksums.shape != (n,) or len(index.coordinates) != residues or len(index.sequences) != residues
                 or index.states.shape != (residues,)):
             raise ValueError(f"{path}: a damaged fold index (its arrays disagree); {REBUILD}")
-        if (index.lengths < MIN_RESIDUES).any() or not np.isfinite(index.descriptors).all():
+        if ((index.lengths < MIN_RESIDUES).any() or not np.isfinite(index.descriptors).all()
+                or not np.isfinite(index.profiles).all()):
             raise ValueError(f"{path}: a damaged fold index (chains shorter than {MIN_RESIDUES} residues or "
-                             f"descriptors that are not finite numbers); {REBUILD}")
+                             f"descriptors or profiles that are not finite numbers); {REBUILD}")
         return index
 
 
-def _mapped(path: Path, name: str) -> np.ndarray:
-    """The array ``name`` of an uncompressed ``.npz`` archive, mapped read-only from the file."""
-    with zipfile.ZipFile(path) as archive:
-        info = archive.getinfo(f"{name}.npy")
-    if info.compress_type != zipfile.ZIP_STORED:
-        raise ValueError(f"{name} is compressed")
-    with open(path, "rb") as file:
-        file.seek(info.header_offset)
-        header = file.read(30)  # the zip entry's local header, then its name and extra field
-        file.seek(info.header_offset + 30 + int.from_bytes(header[26:28], "little")
-                  + int.from_bytes(header[28:30], "little"))
-        version = np.lib.format.read_magic(file)
-        shape, fortran, dtype = (np.lib.format.read_array_header_1_0(file) if version == (1, 0)
-                                 else np.lib.format.read_array_header_2_0(file))
-        offset = file.tell()
-    if dtype.hasobject or fortran:
-        raise ValueError(f"{name} is not a plain array")
-    if not np.prod(shape):
-        return np.zeros(shape, dtype=dtype)
-    return np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape)
+class FileArray:
+    """A plain array of an uncompressed ``.npz`` archive, read from the file as rows are asked
+    for (``array[k]``, ``array[a:b]``; anything else reads it whole). Unlike a mapping, what a
+    search reads stays in the system's file cache, out of the process's resident memory."""
+
+    def __init__(self, path: Path, name: str) -> None:
+        with zipfile.ZipFile(path) as archive:
+            info = archive.getinfo(f"{name}.npy")
+        if info.compress_type != zipfile.ZIP_STORED:
+            raise ValueError(f"{name} is compressed")
+        self._file = open(path, "rb")  # noqa: SIM115 - kept open for the reads, closed with the array
+        self._file.seek(info.header_offset)
+        header = self._file.read(30)  # the zip entry's local header, then its name and extra field
+        self._file.seek(info.header_offset + 30 + int.from_bytes(header[26:28], "little")
+                        + int.from_bytes(header[28:30], "little"))
+        version = np.lib.format.read_magic(self._file)
+        self.shape, fortran, self.dtype = (np.lib.format.read_array_header_1_0(self._file) if version == (1, 0)
+                                           else np.lib.format.read_array_header_2_0(self._file))
+        if self.dtype.hasobject or fortran or not self.shape:
+            raise ValueError(f"{name} is not a plain array")
+        self._offset = self._file.tell()
+        self._row = self.dtype.itemsize * int(np.prod(self.shape[1:]))
+        if self._offset + self.nbytes > os.fstat(self._file.fileno()).st_size:
+            raise ValueError(f"{name} is cut short")
+
+    def __del__(self) -> None:
+        if hasattr(self, "_file"):
+            self._file.close()
+
+    @property
+    def nbytes(self) -> int:
+        return self._row * self.shape[0]
+
+    def __len__(self) -> int:
+        return self.shape[0]
+
+    def __getitem__(self, key: object) -> np.ndarray:
+        if isinstance(key, (int, np.integer)) and -len(self) <= key < len(self):
+            return self[int(key) % len(self):int(key) % len(self) + 1][0]
+        if isinstance(key, slice) and key.step in (None, 1):
+            first, stop, _ = key.indices(len(self))
+            count = max(stop - first, 0)
+            rows = np.empty((count, *self.shape[1:]), dtype=self.dtype)
+            if count and os.preadv(self._file.fileno(), [rows.view(np.uint8).reshape(-1)],
+                                   self._offset + first * self._row) != rows.nbytes:
+                raise ValueError("the file was cut short while it was read")
+            return rows
+        return np.asarray(self)[key]
+
+    def __array__(self, dtype: np.dtype | None = None, copy: bool | None = None) -> np.ndarray:
+        whole = self[:]
+        return whole if dtype is None else whole.astype(dtype)
 
 
 def index_structure(structure: Structure, path: Path | str = "") -> FoldIndex:
@@ -258,6 +348,7 @@ def index_structure(structure: Structure, path: Path | str = "") -> FoldIndex:
         lengths=np.array([len(ca) for ca in coordinates], dtype=np.int64),
         descriptors=np.array([curve_descriptor(ca) for ca in coordinates], dtype=np.float16).reshape(
             -1, DESCRIPTOR_SIZE),
+        profiles=np.array([pair_profile(chain) for chain in chain_states], dtype=np.float16).reshape(-1, PROFILE_SIZE),
         checksums=np.array([checksum(*chain) for chain in zip(coordinates, codes, chain_states)], dtype=np.uint32),
         coordinates=np.concatenate(coordinates or [np.zeros((0, 3), dtype=np.float32)]),
         sequences=np.concatenate(codes or [np.zeros(0, dtype="S1")]),
@@ -354,8 +445,8 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
     E-value of ``max_evalue`` or less or a TM-score of :data:`~core.analysis.compare.SAME_FOLD`
     or more.
 
-    Every chain (of an index of more than :data:`SCORED` chains, the nearest :data:`SCORED` by
-    descriptor) is scored by the local alignment of its 3Di states and amino acids with the
+    Every chain (of an index of more than :data:`SCORED` chains, those nearest the query by
+    descriptor or by pair profile, :data:`SCORED` / 2 each) is scored by the local alignment of its 3Di states and amino acids with the
     query's; the best ``aligned`` are aligned by structure and come first, by their fold score:
     the TM-score (normalised by the query) plus :data:`SCORE_SHARE` times the alignment score
     relative to the query's with itself. The rest follow by score.
@@ -370,7 +461,9 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
     profile = query_profile(query_states, names)
     if len(index) > SCORED:
         distance = descriptor_distances(index.descriptors, curve_descriptor(ca))
-        rows = np.sort(np.argpartition(distance, SCORED)[:SCORED])
+        similarity = profile_similarities(index.profiles, pair_profile(query_states))
+        rows = np.union1d(np.argpartition(distance, SCORED // 2)[:SCORED // 2],
+                          np.argpartition(-similarity, SCORED // 2)[:SCORED // 2])
     else:
         rows = np.arange(len(index))
     scores = alignment_scores(index, profile, rows)

@@ -44,12 +44,13 @@ def read_index(path: Path) -> FoldIndex:
 
 def test_the_index_holds_every_protein_chain_of_20_residues_or_more(index_file):
     index = read_index(index_file)
-    chains = sorted(zip(index.entries.tolist(), index.chains.tolist()))
+    chains = sorted(zip(np.asarray(index.entries).tolist(), np.asarray(index.chains).tolist()))
     # 1ACB: chymotrypsin E and eglin c I (70); 1TIM: A and B; 3SGB: E and the inhibitor I (56);
     # 1L2Y (20 residues) counts, 1BNA (DNA) has none
     assert chains == [("1ACB", "E"), ("1ACB", "I"), ("1BMA", "A"), ("1BPI", "A"), ("1L2Y", "A"), ("1TIM", "A"),
                       ("1TIM", "B"), ("1UBQ", "A"), ("2K39_CA-only", "A"), ("3PTB", "A"), ("3SGB", "E"), ("3SGB", "I")]
     assert index.descriptors.dtype == np.float16 and index.descriptors.shape == (12, 247)
+    assert index.profiles.dtype == np.float16 and index.profiles.shape == (12, 32)
     assert len(index.coordinates) == index.lengths.sum() == len(index.sequences) == len(index.states)
     with np.load(index_file, allow_pickle=False) as archive:  # plain arrays: no pickled objects
         assert set(archive.files) == set(FIELDS)
@@ -126,7 +127,8 @@ def test_bad_input(argv, message, tmp_path, capsys):
 
 @pytest.mark.parametrize(("damage", "message"), [
     ("no chain", "a fold index of no chain"),
-    ("infinite descriptors", "descriptors that are not finite numbers"),
+    ("infinite descriptors", "descriptors or profiles that are not finite numbers"),
+    ("a profile of NaN", "descriptors or profiles that are not finite numbers"),
     ("a chain of 0 residues", "chains shorter than 20 residues"),
     ("infinite coordinates", "non-finite coordinates"),
     ("lengths that disagree", "its arrays disagree"),
@@ -145,6 +147,8 @@ def test_a_damaged_index_asks_to_be_built_again(index_file, tmp_path, capsys, da
         arrays = {name: array[:0] for name, array in arrays.items()}
     elif damage == "infinite descriptors":
         arrays["descriptors"][3] = np.inf
+    elif damage == "a profile of NaN":
+        arrays["profiles"][2] = np.nan
     elif damage == "a chain of 0 residues":
         arrays["lengths"][1], arrays["lengths"][2] = 0, arrays["lengths"][1] + arrays["lengths"][2]
     elif damage == "infinite coordinates":

@@ -11,6 +11,7 @@ from scipy.spatial.transform import Rotation
 from core.analysis.fold_alignment import align_folds
 from core.analysis.fold_search import (
     DESCRIPTOR_SIZE,
+    FileArray,
     FoldIndex,
     curve_descriptor,
     descriptor_distances,
@@ -108,7 +109,7 @@ def test_the_index_file_round_trip_and_refusals(index, tmp_path) -> None:
     again = FoldIndex.read(path)
     for name in ("entries", "chains", "lengths", "descriptors", "coordinates", "sequences", "states"):
         assert np.array_equal(getattr(again, name), getattr(index, name))
-    assert all(isinstance(getattr(again, name), np.memmap) for name in ("coordinates", "sequences", "states"))
+    assert all(isinstance(getattr(again, name), FileArray) for name in ("coordinates", "sequences", "states"))  # read per chain
     ca, codes = index.chain(3)
     assert [(h.row, h.match.tm_score_a) for h in search(again, ca, codes.tobytes().decode(), top=3)] == [
         (h.row, h.match.tm_score_a) for h in search(index, ca, codes.tobytes().decode(), top=3)]
@@ -140,3 +141,18 @@ def test_sensitivity_counts_true_positives_up_to_the_first_other_fold() -> None:
     assert np.allclose(sensitivity(np.array([6, 1, 2]), family, superfamily, fold, 0), [0, 0, 0])
     assert np.allclose(sensitivity(np.array([1]), family, superfamily, fold, 0), [1 / 2, 0, 0])  # a short list
     assert sensitivity(ranked, family, superfamily, np.where(fold == "F", "G", fold), 6) is None  # no true positive
+
+
+def test_a_large_index_scores_only_the_nearest_by_descriptor_and_by_pair_profile(index, monkeypatch) -> None:
+    """Above ``SCORED`` chains, half of them nearest the query's descriptor and half nearest its
+    profile of 3Di state pairs are aligned: elastase still finds itself and trypsin."""
+    from core.analysis import fold_search
+
+    monkeypatch.setattr(fold_search, "SCORED", 4)
+    ca, codes = index.chain(int(np.flatnonzero(index.entries == "1BMA")[0]))
+    hits = search(index, ca, codes.tobytes().decode(), top=len(index), max_evalue=np.inf)
+    assert [h.entry for h in hits[:2]] == ["1BMA", "3PTB"] and 2 <= len(hits) <= 4
+    profiles = index.profiles.astype(np.float32)
+    assert np.allclose(np.linalg.norm(profiles, axis=1), 1.0, atol=2e-3)  # unit vectors, as float16
+    similarity = fold_search.profile_similarities(index.profiles, profiles[3])
+    assert similarity[3] == pytest.approx(1.0, abs=2e-3) and similarity[2] > max(similarity[0], similarity[4])
