@@ -133,14 +133,15 @@ fi
 
 # numba compiles the structural alignment's kernels on their first use (a minute or two on a
 # busy machine) and caches them: done here, the first comparison or search does not wait.
-echo "setup.sh: compiling the structural alignment" >&2
-"$venv/bin/python" - <<'PY'
-import numpy as np
+echo "setup.sh: compiling the structural alignment and the fold search" >&2
+"$venv/bin/python" - "$root/resources/examples/1UBQ.pdb" <<'PY'
+import sys
 from core.analysis.fold_alignment import align_folds
-from core.analysis.tm_align import screen
-turns = np.arange(40.0)
-helix = np.stack([2.3 * np.cos(1.75 * turns), 2.3 * np.sin(1.75 * turns), 1.5 * turns], axis=1)
-align_folds(helix, helix[::-1].copy())
-screen(helix, helix, np.array([0]), np.array([40]), 4)
+from core.analysis.fold_search import index_structure, search
+from core.protein.reading import read_structure
+index = index_structure(read_structure(sys.argv[1]))
+ca, codes = index.chain(0)
+search(index, ca, codes.tobytes().decode())
+align_folds(ca, ca[::-1].copy())
 PY
 echo "$sums" >"$stamp"
