@@ -5,8 +5,9 @@ Usage: ``python benchmarks/bench_fold_search.py --scop FOLDER [--tm-align N] [--
 or ``... --pdb-scale N --base FOLDER --scratch DIR``.
 
 ``FOLDER`` is laid out as the shared ``scop40-dev`` (``labels.tsv``, ``queries.txt``,
-``domains/``). Every domain is indexed (as ``ribbonwave index`` does); for each query, every
-other domain is ranked, and the share of its true positives (same family; same superfamily,
+``domains/``). Every domain is indexed (as ``ribbonwave index`` does; ``--also FOLDER...``: with
+the labelled domains of other such sets, as the benchmark's two halves in one index); for each
+query, every other domain is ranked, and the share of its true positives (same family; same superfamily,
 other family; same fold, other superfamily) ranked before the first domain of another fold is
 averaged over the queries. One line per method, with the CPU seconds per query:
 
@@ -118,15 +119,18 @@ def screen_kept(index: FoldIndex, queries: list[int], labels: dict[str, np.ndarr
           + f"{np.mean(cpu):>13.3f}", flush=True)
 
 
-def scop_sensitivity(folder: Path, tm_align_queries: int, decoys: Path | None) -> None:
-    table = {row[0]: row for row in (line.split("\t") for line in (folder / "labels.tsv").read_text().splitlines()[1:])}
-    index, seconds = build_index(sorted((folder / "domains").glob("*.pdb.gz")))
-    names = [str(entry) for entry in index.entries]
+def scop_sensitivity(folder: Path, tm_align_queries: int, decoys: Path | None, others: list[Path]) -> None:
+    table = {row[0]: row for labelled in [folder, *others]
+             for row in (line.split("\t") for line in (labelled / "labels.tsv").read_text().splitlines()[1:])}
+    index, seconds = build_index(sorted(path for labelled in [folder, *others]
+                                        for path in (labelled / "domains").glob("*.pdb.gz")))
+    names = [Path(str(path)).name.removesuffix(".pdb.gz") for path in index.paths]  # the domains, as labelled
     labels = {level: np.array([table[name][2 + k] for name in names], dtype=object) for k, level in enumerate(LEVELS)}
     queries = [names.index(name) for name in (folder / "queries.txt").read_text().split()]
     chains = [chain(index, row) for row in range(len(index))]
     every = len(index)
-    print(f"{folder}: {len(index)} domains indexed in {seconds:.1f} s, {len(queries)} queries; sensitivity up to "
+    print(f"{folder}{''.join(f' + {other}' for other in others)}: {len(index)} domains indexed in {seconds:.1f} s, "
+          f"{len(queries)} queries of {folder}; sensitivity up to "
           "the first false positive (another fold), family / superfamily / fold")
     search(index, *chains[queries[0]])  # loads the compiled kernels
     print(f"{'method':<52}{'queries':>8}{'family':>8}{'superfam.':>10}{'fold':>7}{'CPU s/query':>13}")
@@ -250,6 +254,8 @@ def main() -> None:
     parser.add_argument("--tm-align", type=int, default=0, metavar="N",
                         help="also rank the first N queries by exhaustive TM-align (slow: about a minute each)")
     parser.add_argument("--decoys", type=Path, metavar="FOLDER", help="structures whose chains pad the index")
+    parser.add_argument("--also", type=Path, nargs="*", default=[], metavar="FOLDER",
+                        help="--scop: other labelled sets whose domains join the index (their queries are not run)")
     parser.add_argument("--pdb-scale", type=int, metavar="N", help="time a query against an index of N chains")
     parser.add_argument("--base", type=Path, metavar="FOLDER", help="--pdb-scale: the structures to repeat")
     parser.add_argument("--scratch", type=Path, metavar="DIR", help="--pdb-scale: where to write the index")
@@ -264,7 +270,7 @@ def main() -> None:
             parser.error("--pdb-scale needs --base and --scratch")
         pdb_scale(args.pdb_scale, args.base, args.scratch)
     elif args.scop is not None:
-        scop_sensitivity(args.scop, args.tm_align, args.decoys)
+        scop_sensitivity(args.scop, args.tm_align, args.decoys, args.also)
     else:
         parser.error("give --scop FOLDER or --pdb-scale N")
 
