@@ -54,21 +54,17 @@ import tmtools
 
 from app.cli.batch import structure_paths
 from core.analysis.compare import SAME_FOLD
-from core.analysis.fold_search import (
+from core.analysis.fold_index import (
     FIELDS,
     FORMAT,
-    SCORED,
     FoldIndex,
-    alignment_scores,
     checksum,
     descriptor_distances,
     index_path,
     merge,
     profile_similarities,
-    query_profile,
-    search,
-    sensitivity,
 )
+from core.analysis.fold_search import SCORED, alignment_scores, query_profile, search, sensitivity
 
 LEVELS = ("family", "superfamily", "fold")
 PDB_CHAINS = 800_000

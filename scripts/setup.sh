@@ -137,7 +137,8 @@ echo "setup.sh: compiling the structural alignment and the fold search" >&2
 "$venv/bin/python" - "$root/resources/examples/1UBQ.pdb" <<'PY'
 import sys
 from core.analysis.fold_alignment import align_folds
-from core.analysis.fold_search import index_structure, search
+from core.analysis.fold_index import index_structure
+from core.analysis.fold_search import search
 from core.protein.reading import read_structure
 index = index_structure(read_structure(sys.argv[1]))
 ca, codes = index.chain(0)

@@ -19,7 +19,7 @@ paste into :mod:`core.analysis.structural_alphabet` and :mod:`core.analysis.fold
 
 It writes ``core/analysis/state_pairs.npz`` (first, as the index needs it): the pair profile's
 weights (the inverse document frequency of each of the 400 pairs of 3Di states over the
-chains), mean and its :data:`~core.analysis.fold_search.PROFILE_SIZE` principal axes.
+chains), mean and its :data:`~core.analysis.fold_index.PROFILE_SIZE` principal axes.
 """
 
 from __future__ import annotations
@@ -33,16 +33,8 @@ from scipy import stats
 
 from app.cli.batch import structure_paths
 from core.analysis.fold_alignment import align_folds
-from core.analysis.fold_search import (
-    PAIR_BASIS,
-    PROFILE_SIZE,
-    FoldIndex,
-    alignment_scores,
-    descriptor_distances,
-    index_path,
-    merge,
-    query_profile,
-)
+from core.analysis.fold_index import PAIR_BASIS, PROFILE_SIZE, FoldIndex, descriptor_distances, index_path, merge
+from core.analysis.fold_search import alignment_scores, query_profile
 from core.analysis.structural_alphabet import STATES, residue_frames, states
 
 PEPTIDE = 4.2

@@ -24,20 +24,8 @@ from app.cli.batch import batch_arguments, run_tasks, structure_paths
 from app.cli.structure import load
 from app.errors import InputError
 from core.analysis.database import SkippedFile
-from core.analysis.fold_search import (
-    ALIGNED,
-    DESCRIPTOR_SIZE,
-    MAX_EVALUE,
-    MIN_RESIDUES,
-    PROFILE_SIZE,
-    SCORED,
-    TOP,
-    FoldIndex,
-    Hit,
-    index_path,
-    merge,
-    search,
-)
+from core.analysis.fold_index import DESCRIPTOR_SIZE, MIN_RESIDUES, PROFILE_SIZE, FoldIndex, index_path, merge
+from core.analysis.fold_search import ALIGNED, MAX_EVALUE, SCORED, TOP, Hit, search
 from core.protein.structure import Structure
 from core.protein.writing import atomic_write
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from app.main import main
-from core.analysis.fold_search import FIELDS, FoldIndex
+from core.analysis.fold_index import FIELDS, FoldIndex
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 ENTRIES = ["3PTB.pdb.gz", "1BMA.pdb.gz", "3SGB.pdb.gz", "1ACB.pdb.gz", "1UBQ.pdb.gz", "2K39_CA-only.pdb.gz",
@@ -139,7 +139,7 @@ def test_bad_input(argv, message, tmp_path, capsys):
 def test_a_damaged_index_asks_to_be_built_again(index_file, tmp_path, capsys, damage, message):
     """Each of these gave a traceback (ZeroDivisionError, IndexError, ...); each now says what is
     wrong and how to rebuild the index (#37)."""
-    from core.analysis.fold_search import FORMAT
+    from core.analysis.fold_index import FORMAT
 
     index = read_index(index_file)
     arrays = {name: np.array(getattr(index, name)) for name in FIELDS[1:]}

@@ -9,18 +9,17 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from core.analysis.fold_alignment import align_folds
-from core.analysis.fold_search import (
+from core.analysis.fold_index import (
     DESCRIPTOR_SIZE,
     FileArray,
     FoldIndex,
     curve_descriptor,
     descriptor_distances,
-    evalues,
     index_path,
     merge,
-    search,
-    sensitivity,
+    profile_similarities,
 )
+from core.analysis.fold_search import evalues, search, sensitivity
 from core.analysis.local_alignment import local_pairs, local_scores
 from core.curves.wavelets import smooth
 
@@ -154,5 +153,5 @@ def test_a_large_index_scores_only_the_nearest_by_descriptor_and_by_pair_profile
     assert [h.entry for h in hits[:2]] == ["1BMA", "3PTB"] and 2 <= len(hits) <= 4
     profiles = index.profiles.astype(np.float32)
     assert np.allclose(np.linalg.norm(profiles, axis=1), 1.0, atol=2e-3)  # unit vectors, as float16
-    similarity = fold_search.profile_similarities(index.profiles, profiles[3])
+    similarity = profile_similarities(index.profiles, profiles[3])
     assert similarity[3] == pytest.approx(1.0, abs=2e-3) and similarity[2] > max(similarity[0], similarity[4])
