@@ -25,7 +25,7 @@ from app.cli.structure import load
 from app.errors import InputError
 from core.analysis.database import SkippedFile
 from core.analysis.fold_index import DESCRIPTOR_SIZE, MIN_RESIDUES, PROFILE_SIZE, FoldIndex, index_path, merge
-from core.analysis.fold_search import ALIGNED, MAX_EVALUE, SCORED, TOP, Hit, search
+from core.analysis.fold_search import ALIGNED, MAX_EVALUE, PROFILED, SCORED, TOP, Hit, search
 from core.protein.structure import Structure
 from core.protein.writing import atomic_write
 
@@ -85,7 +85,8 @@ def search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--top", type=bounded(int, 1, 100000), default=TOP, metavar="K",
                         help="hits to list at most (default %(default)s)")
     parser.add_argument("--aligned", type=bounded(int, 1, 100000), default=ALIGNED, metavar="A",
-                        help="chains of best alignment score that are aligned by structure (default %(default)s)")
+                        help="chains of best alignment score that are aligned by structure, besides the "
+                        f"{PROFILED} nearest by pair profile (default %(default)s)")
     parser.add_argument("--max-evalue", type=bounded(float, 0.0, 1e9), default=MAX_EVALUE, metavar="E",
                         help="leave out hits of a larger E-value, unless their TM-score is 0.5 or more "
                         "(default %(default)s)")
@@ -120,7 +121,7 @@ def run_search(args: argparse.Namespace) -> int:
         "query_length": len(ca),
         "searched": len(index),
         "scored": min(len(index), SCORED),
-        "aligned": min(args.aligned, len(index)),
+        "aligned": min(args.aligned + PROFILED, len(index)),
         "max_evalue": args.max_evalue,
         "seconds": round(seconds, 3),
         "hits": [_hit(hit) for hit in hits],
@@ -145,8 +146,8 @@ def _hit(hit: Hit) -> dict:
 
 def _table(report: dict) -> str:
     lines = [f"{report['query']} ({report['query_length']} residues) against {report['searched']} chains: "
-             f"{report['scored']} scored by the alignment of 3Di states and amino acids, the best "
-             f"{report['aligned']} aligned by structure, in {report['seconds']:.2f} s; "
+             f"{report['scored']} scored by the alignment of 3Di states and amino acids, {report['aligned']} (the best "
+             f"and the nearest by pair profile) aligned by structure, in {report['seconds']:.2f} s; "
              f"{len(report['hits'])} hits of E-value {report['max_evalue']:g} or less or TM-score 0.5 or more",
              "TM-score normalised by the query (and by the hit); below 0.5 the folds differ; E-value: the unrelated "
              "chains expected to score as high",

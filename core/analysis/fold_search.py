@@ -57,6 +57,9 @@ SCORED = 10_000
 descriptor and :data:`SCORED` / 2 nearest by pair profile scored."""
 ALIGNED = 30
 """Chains of best local alignment score that :func:`search` aligns by structure."""
+PROFILED = 10
+"""Chains nearest the query's pair profile that :func:`search` aligns by structure as well,
+whatever their alignment score (remote matches whose 3Di strings align poorly)."""
 REFINE_ROUNDS = 2
 """Rounds of TM-align's refinement of their local alignment (:func:`refine_pairs`)."""
 MATCH_STEP = 4
@@ -133,10 +136,12 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
     or more.
 
     Every chain (of an index of more than :data:`SCORED` chains, those nearest the query by
-    descriptor or by pair profile, :data:`SCORED` / 2 each) is scored by the local alignment of its 3Di states and amino acids with the
-    query's; the best ``aligned`` are aligned by structure and come first, by their fold score:
-    the TM-score (normalised by the query) plus :data:`SCORE_SHARE` times the alignment score
-    relative to the query's with itself. The rest follow by score.
+    descriptor or by pair profile, :data:`SCORED` / 2 each) is scored by the local alignment
+    of its 3Di states and amino acids with the query's. The best ``aligned``, and the
+    :data:`PROFILED` others nearest the query's pair profile, are aligned by structure and
+    come first, by their fold score: the TM-score (normalised by the query) plus
+    :data:`SCORE_SHARE` times the alignment score relative to the query's with itself. The rest
+    follow by score.
 
     Parameters
     ----------
@@ -146,9 +151,9 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
     names = np.frombuffer(sequence.encode("ascii", "replace"), dtype="S1")
     query_states = states(ca)
     profile = query_profile(query_states, names)
+    similarity = profile_similarities(index.profiles, pair_profile(query_states))
     if len(index) > SCORED:
         distance = descriptor_distances(index.descriptors, curve_descriptor(ca))
-        similarity = profile_similarities(index.profiles, pair_profile(query_states))
         rows = np.union1d(np.argpartition(distance, SCORED // 2)[:SCORED // 2],
                           np.argpartition(-similarity, SCORED // 2)[:SCORED // 2])
     else:
@@ -158,8 +163,12 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
                              np.array([len(ca)]), GAP_OPEN, GAP_EXTEND)[0])
     expected = evalues(scores, len(ca), index.lengths[rows], len(index))
     order = np.argsort(-scores, kind="stable")
+    chosen = order[:aligned].tolist()
+    taken = set(chosen)
+    chosen += [k for k in np.argsort(-similarity[rows], kind="stable")[:aligned + PROFILED].tolist()
+               if k not in taken][:PROFILED]
     matches, fold_scores = {}, {}
-    for k in order[:aligned].tolist():
+    for k in chosen:
         row = int(rows[k])
         other, other_names = index.chain(row)
         other_states = np.asarray(index.states[index.starts[row]:index.starts[row] + index.lengths[row]])

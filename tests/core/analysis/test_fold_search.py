@@ -71,6 +71,17 @@ def test_search_ranks_the_proteases_by_their_alignment_and_fold_score(index) -> 
     assert [h.entry for h in search(index, ca, codes.tobytes().decode(), top=3, aligned=2)][:2] == ["1BMA", "3PTB"]
 
 
+def test_the_chains_nearest_by_pair_profile_are_aligned_whatever_their_score(index, monkeypatch) -> None:
+    from core.analysis import fold_search
+
+    ca, codes = index.chain(int(np.flatnonzero(index.entries == "1BMA")[0]))
+    hits = search(index, ca, codes.tobytes().decode(), top=len(index), aligned=1, max_evalue=np.inf)
+    assert all(h.match is not None for h in hits)  # 1 by score, the 5 others by profile
+    monkeypatch.setattr(fold_search, "PROFILED", 0)
+    hits = search(index, ca, codes.tobytes().decode(), top=len(index), aligned=1, max_evalue=np.inf)
+    assert [h.match is not None for h in hits] == [True] + [False] * (len(index) - 1)
+
+
 def test_search_leaves_out_what_is_neither_significant_nor_of_the_fold(index) -> None:
     """In an index of 6 chains any unrelated chain scores as well as 2 or more others would (an
     E-value of 2 to 4); ubiquitin's NMR model (Cα only) is significant at 1e-11."""
