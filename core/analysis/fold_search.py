@@ -9,7 +9,8 @@ and amino acids, scored against the query's by local alignment, the best aligned
    (:func:`alignment_scores`, :mod:`core.analysis.local_alignment`: 3Di substitution scores
    plus :data:`AMINO_ACID_WEIGHT` times BLOSUM62, affine gaps) ranks the database, about 340
    million cells a CPU second, and gives each chain an E-value (:func:`evalues`).
-2. The :data:`ALIGNED` best are aligned by structure: their local alignment, refined by two
+2. The :data:`ALIGNED` best, and the :data:`PROFILED` others nearest the query's profile of
+   3Di state pairs, are aligned by structure: their local alignment, refined by two
    rounds of TM-align's dynamic programming on the superposed chains (:func:`refine_pairs`),
    gives the TM-score, rms and identity of each (:class:`~core.analysis.compare.FoldMatch`).
    They come first, by their fold score, the TM-score plus :data:`SCORE_SHARE` times the
@@ -17,7 +18,7 @@ and amino acids, scored against the query's by local alignment, the best aligned
 
 On SCOP40's development half (Foldseek's benchmark, ``benchmarks/bench_fold_search.py``) this
 finds as many superfamilies and folds as exhaustive TM-align, and nearly all its families, at
-1/150 of its CPU: the cost of a query grows with the database only by its first step.
+about 1/100 of its CPU: the cost of a query grows with the database only by its first step.
 
 An index of more than :data:`SCORED` chains (the PDB has 800,000) scores by local alignment
 only the :data:`SCORED` / 2 nearest the query by each of the index's two summaries of a chain
