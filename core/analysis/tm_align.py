@@ -705,6 +705,15 @@ def _states_pairing(states_x: np.ndarray, states_y: np.ndarray, invmap: np.ndarr
 
 
 @njit(cache=True)
+def _search_scales(shorter: int) -> tuple[float, float, float]:
+    """TM-align's scales of the search for chains whose shorter has ``shorter`` residues: its
+    d0 (the TM-score's, plus 0.8 Å), the d0 of the superposition search and the cutoff of the
+    pairs kept (Å)."""
+    d0 = (0.168 if shorter <= 19 else 1.24 * (shorter - 15.0) ** (1.0 / 3.0) - 1.8) + 0.8
+    return d0, min(max(d0, 4.5), 8.0), 1.5 * shorter**0.3 + 3.5
+
+
+@njit(cache=True)
 def align(x: np.ndarray, y: np.ndarray, given: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, np.ndarray]:
     """TM-align's search for the alignment of chains x (n, 3) and y (m, 3), 3 residues or more
     each, with ``given``, a pairing (m,) to start from as well (all -1: none).
@@ -716,9 +725,7 @@ def align(x: np.ndarray, y: np.ndarray, given: np.ndarray) -> tuple[np.ndarray, 
     xlen, ylen = len(x), len(y)
     states_x, states_y = secondary_states(x), secondary_states(y)
     shorter = min(xlen, ylen)
-    d0 = (0.168 if shorter <= 19 else 1.24 * (shorter - 15.0) ** (1.0 / 3.0) - 1.8) + 0.8
-    d0_search = min(max(d0, 4.5), 8.0)
-    cut = 1.5 * shorter**0.3 + 3.5
+    d0, d0_search, cut = _search_scales(shorter)
     ddcc = 0.1 if shorter <= 40 else 0.4
     best_map, invmap = np.full(ylen, -1, dtype=np.int64), np.full(ylen, -1, dtype=np.int64)
     best = -1.0
@@ -761,9 +768,7 @@ def refine(x: np.ndarray, y: np.ndarray, given: np.ndarray, rounds: int) -> tupl
     start): TM-score's search of its pairs, then ``rounds`` rounds of :func:`_dp_iterations`.
     Returns the best pairing (``invmap``) and its TM-score in the search (as :func:`align`)."""
     shorter = min(len(x), len(y))
-    d0 = (0.168 if shorter <= 19 else 1.24 * (shorter - 15.0) ** (1.0 / 3.0) - 1.8) + 0.8
-    d0_search = min(max(d0, 4.5), 8.0)
-    cut = 1.5 * shorter**0.3 + 3.5
+    d0, d0_search, cut = _search_scales(shorter)
     best_map = given.copy()
     best, rotation, translation = _detailed_search(x, y, given, SIMPLIFY_STEP, d0, d0_search, cut, shorter)
     if best < 0.0:
