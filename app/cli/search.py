@@ -25,7 +25,7 @@ from app.cli.structure import load
 from app.errors import InputError
 from core.analysis.database import SkippedFile
 from core.analysis.fold_index import DESCRIPTOR_SIZE, MIN_RESIDUES, PROFILE_SIZE, FoldIndex, index_path, merge
-from core.analysis.fold_search import ALIGNED, MAX_EVALUE, PROFILED, SCORED, TOP, Hit, search
+from core.analysis.fold_search import ALIGNED, MAX_EVALUE, PROFILED, TOP, Hit, chains_scored, search
 from core.protein.structure import Structure
 from core.protein.writing import atomic_write
 
@@ -120,7 +120,7 @@ def run_search(args: argparse.Namespace) -> int:
         "query": f"{path} chain {chain}",
         "query_length": len(ca),
         "searched": len(index),
-        "scored": min(len(index), SCORED),
+        "scored": chains_scored(index, len(ca)),
         "aligned": min(args.aligned + PROFILED, len(index)),
         "max_evalue": args.max_evalue,
         "seconds": round(seconds, 3),

@@ -8,7 +8,7 @@ lengths and checksums into memory, the names and the per-residue arrays (14 byte
 from the file as they are used (:class:`FileArray`), each chain checked against its CRC-32.
 
 The summaries, for an index too large to align with every chain
-(:data:`core.analysis.fold_search.SCORED`):
+(:func:`core.analysis.fold_search.chains_scored`):
 
 - :func:`curve_descriptor`, Carson's coarse curves: the Cα trace resampled evenly to the
   control points of level 6, smoothed by the curve wavelets to its least-squares best curves

@@ -20,11 +20,13 @@ On SCOP40's development half (Foldseek's benchmark, ``benchmarks/bench_fold_sear
 finds as many superfamilies and folds as exhaustive TM-align, and nearly all its families, at
 about 1/100 of its CPU: the cost of a query grows with the database only by its first step.
 
-An index of more than :data:`SCORED` chains (the PDB has 800,000) scores by local alignment
-only the :data:`SCORED` / 2 nearest the query by each of the index's two summaries of a chain
+A query against a large index (the PDB has 800,000 chains) may spend :data:`SCORED_CELLS` cells
+of local alignment, about a CPU second (:func:`chains_scored`): the chains it scores are the
+nearest to it, half by each of the index's two summaries of a chain
 (:mod:`core.analysis.fold_index`: Carson's coarse curves and the profile of consecutive 3Di
-state pairs). Together they keep about 80% of the family matches, 55% of the superfamily and
-33% of the fold matches of SCOP40 at that scale; neither knows domains.
+state pairs). For a query of 200 residues among 800,000 chains like the shared set's (200 residues
+on average), that is the 12,000 nearest by each; they keep about 85% of the family matches, 60%
+of the superfamily and 40% of the fold matches of SCOP40; neither summary knows domains.
 """
 
 from __future__ import annotations
@@ -53,9 +55,9 @@ GAP_OPEN, GAP_EXTEND = 10.0, 1.0
 SCORE_SLOPE, SCORE_LOCATION, SCORE_SCALE = 15.2322, -113.9755, 18.8031
 """The local alignment scores of unrelated chains of m and n residues: ``SCORE_SLOPE ln(m n)``
 plus a Gumbel variable of this location and scale (``scripts/train_fold_scores.py``)."""
-SCORED = 10_000
-"""Chains scored by local alignment: an index of more has its :data:`SCORED` / 2 nearest by
-descriptor and :data:`SCORED` / 2 nearest by pair profile scored."""
+SCORED_CELLS = 1_000_000_000
+"""Cells of local alignment (query residues × chain residues) a query may spend, about a CPU
+second: against an index of more, only the chains nearest the query are scored (:func:`chains_scored`)."""
 ALIGNED = 30
 """Chains of best local alignment score that :func:`search` aligns by structure."""
 PROFILED = 10
@@ -102,6 +104,16 @@ def alignment_scores(index: FoldIndex, profile: np.ndarray, rows: np.ndarray) ->
     return local_scores(profile, codes, starts, lengths, GAP_OPEN, GAP_EXTEND)
 
 
+def chains_scored(index: FoldIndex, query_length: int) -> int:
+    """How many chains of ``index`` :func:`search` scores by local alignment for a query of
+    ``query_length`` residues: every chain, or as many chains of the index's mean length as
+    :data:`SCORED_CELLS` holds (an even number, at least 2)."""
+    residues = int(index.lengths.sum())
+    if query_length * residues <= SCORED_CELLS:
+        return len(index)
+    return max(2, int(SCORED_CELLS * len(index) / (query_length * residues)) // 2 * 2)
+
+
 def evalues(scores: np.ndarray, query_length: int, lengths: np.ndarray, chains: int) -> np.ndarray:
     """The expected number of chains of unrelated folds, among ``chains``, that align to a
     query of ``query_length`` residues with a score of ``scores`` or more (chains of
@@ -136,8 +148,8 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
     E-value of ``max_evalue`` or less or a TM-score of :data:`~core.analysis.compare.SAME_FOLD`
     or more.
 
-    Every chain (of an index of more than :data:`SCORED` chains, those nearest the query by
-    descriptor or by pair profile, :data:`SCORED` / 2 each) is scored by the local alignment
+    Every chain (of a large index, the :func:`chains_scored` nearest the query, half by
+    descriptor and half by pair profile) is scored by the local alignment
     of its 3Di states and amino acids with the query's. The best ``aligned``, and the
     :data:`PROFILED` others nearest the query's pair profile, are aligned by structure and
     come first, by their fold score: the TM-score (normalised by the query) plus
@@ -153,10 +165,11 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
     query_states = states(ca)
     profile = query_profile(query_states, names)
     similarity = profile_similarities(index.profiles, pair_profile(query_states))
-    if len(index) > SCORED:
+    scored = chains_scored(index, len(ca))
+    if scored < len(index):
         distance = descriptor_distances(index.descriptors, curve_descriptor(ca))
-        rows = np.union1d(np.argpartition(distance, SCORED // 2)[:SCORED // 2],
-                          np.argpartition(-similarity, SCORED // 2)[:SCORED // 2])
+        half = scored // 2
+        rows = np.union1d(np.argpartition(distance, half)[:half], np.argpartition(-similarity, half)[:half])
     else:
         rows = np.arange(len(index))
     scores = alignment_scores(index, profile, rows)

@@ -19,7 +19,7 @@ from core.analysis.fold_index import (
     merge,
     profile_similarities,
 )
-from core.analysis.fold_search import evalues, search, sensitivity
+from core.analysis.fold_search import chains_scored, evalues, search, sensitivity
 from core.analysis.local_alignment import LANES, local_pairs, local_scores
 from core.curves.wavelets import smooth
 
@@ -161,12 +161,16 @@ def test_sensitivity_counts_true_positives_up_to_the_first_other_fold() -> None:
 
 
 def test_a_large_index_scores_only_the_nearest_by_descriptor_and_by_pair_profile(index, monkeypatch) -> None:
-    """Above ``SCORED`` chains, half of them nearest the query's descriptor and half nearest its
-    profile of 3Di state pairs are aligned: elastase still finds itself and trypsin."""
+    """Past ``SCORED_CELLS`` cells, only the chains nearest the query are scored, half by
+    descriptor and half by profile of 3Di state pairs, as many as the cells hold (more for a
+    shorter query): elastase still finds itself and trypsin."""
     from core.analysis import fold_search
 
-    monkeypatch.setattr(fold_search, "SCORED", 4)
     ca, codes = index.chain(int(np.flatnonzero(index.entries == "1BMA")[0]))
+    assert chains_scored(index, len(ca)) == len(index)
+    monkeypatch.setattr(fold_search, "SCORED_CELLS", int(4.5 * len(ca) * index.lengths.mean()))
+    assert chains_scored(index, len(ca)) == 4 and chains_scored(index, len(ca) // 2) == len(index)
+    assert chains_scored(index, 100 * len(ca)) == 2
     hits = search(index, ca, codes.tobytes().decode(), top=len(index), max_evalue=np.inf)
     assert [h.entry for h in hits[:2]] == ["1BMA", "3PTB"] and 2 <= len(hits) <= 4
     profiles = index.profiles.astype(np.float32)
