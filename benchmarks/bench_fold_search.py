@@ -1,7 +1,7 @@
 """Fold search measured as the field measures it: Foldseek's sensitivity up to the first false
 positive on a labelled SCOP set, beside exhaustive TM-align, and the cost of a query.
 
-Usage: ``python benchmarks/bench_fold_search.py --scop FOLDER [--tm-align N] [--decoys FOLDER]``,
+Usage: ``python benchmarks/bench_fold_search.py --scop FOLDER [--tm-align N [--jobs J]] [--decoys FOLDER]``,
 or ``... --pdb-scale N --base FOLDER --scratch DIR``.
 
 ``FOLDER`` is laid out as the shared ``scop40-dev`` (``labels.tsv``, ``queries.txt``,
@@ -43,11 +43,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import multiprocessing
 import os
 import subprocess
 import sys
 import time
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -82,13 +84,30 @@ def chain(index: FoldIndex, row: int) -> tuple[np.ndarray, str]:
     return ca, codes.tobytes().decode("ascii")
 
 
-def measure(name: str, rank: Callable[[int], np.ndarray], queries: list[int], labels: dict[str, np.ndarray]) -> None:
-    scores, cpu = [], []
-    for row in queries:
-        start = time.process_time()
-        ranked = rank(row)
-        cpu.append(time.process_time() - start)
-        scores.append(sensitivity(ranked, *(labels[level] for level in LEVELS), row))
+_RANK: Callable[[int], np.ndarray] | None = None
+"""The ranking :func:`measure`'s worker processes run (inherited by fork: closures do not pickle)."""
+
+
+def _timed(row: int) -> tuple[np.ndarray, float]:
+    start = time.process_time()
+    ranked = _RANK(row)
+    return ranked, time.process_time() - start
+
+
+def measure(name: str, rank: Callable[[int], np.ndarray], queries: list[int], labels: dict[str, np.ndarray],
+            jobs: int = 1) -> None:
+    """Print one line of the table: the mean sensitivity of ``rank``'s rankings of ``queries``
+    and its CPU per query (each query timed in the process that ranks it, ``jobs`` at once)."""
+    global _RANK
+    _RANK = rank
+    if jobs > 1:
+        with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork")) as pool:
+            results = list(pool.map(_timed, queries))
+    else:
+        results = [_timed(row) for row in queries]
+    cpu = [seconds for _, seconds in results]
+    scores = [sensitivity(ranked, *(labels[level] for level in LEVELS), row)
+              for (ranked, _), row in zip(results, queries, strict=True)]
     found = np.array([score for score in scores if score is not None])
     print(f"{name:<52}{len(found):>8}" + "".join(f"{value:>{width}.3f}" for value, width in
                                                   zip(found.mean(axis=0), (8, 10, 7), strict=True))
@@ -117,7 +136,8 @@ def screen_kept(index: FoldIndex, queries: list[int], labels: dict[str, np.ndarr
           + f"{np.mean(cpu):>13.3f}", flush=True)
 
 
-def scop_sensitivity(folder: Path, tm_align_queries: int, decoys: Path | None, others: list[Path]) -> None:
+def scop_sensitivity(folder: Path, tm_align_queries: int, decoys: Path | None, others: list[Path],
+                     jobs: int = 1) -> None:
     table = {row[0]: row for labelled in [folder, *others]
              for row in (line.split("\t") for line in (labelled / "labels.tsv").read_text().splitlines()[1:])}
     index, seconds = build_index(sorted(path for labelled in [folder, *others]
@@ -151,7 +171,7 @@ def scop_sensitivity(folder: Path, tm_align_queries: int, decoys: Path | None, o
         measure(f"search on the first {len(asked)} queries", searched, asked, labels)
         measure("exhaustive TM-align (tmtools, by the query)", lambda row: np.argsort(-np.array(
             [tmtools.tm_align(chains[row][0], other, chains[row][1], codes).tm_norm_chain1
-             for other, codes in chains]), kind="stable"), asked, labels)
+             for other, codes in chains]), kind="stable"), asked, labels, jobs)
     if decoys is not None:
         padding, _ = build_index(structure_paths([decoys]))
         padded = merge([index, padding])
@@ -251,6 +271,8 @@ def main() -> None:
                         help="a labelled SCOP set (labels.tsv, queries.txt, domains/)")
     parser.add_argument("--tm-align", type=int, default=0, metavar="N",
                         help="also rank the first N queries by exhaustive TM-align (slow: about a minute each)")
+    parser.add_argument("--jobs", type=int, default=1, metavar="N",
+                        help="--tm-align: rank N queries at once, in worker processes (CPU is still per query)")
     parser.add_argument("--decoys", type=Path, metavar="FOLDER", help="structures whose chains pad the index")
     parser.add_argument("--also", type=Path, nargs="*", default=[], metavar="FOLDER",
                         help="--scop: other labelled sets whose domains join the index (their queries are not run)")
@@ -268,7 +290,7 @@ def main() -> None:
             parser.error("--pdb-scale needs --base and --scratch")
         pdb_scale(args.pdb_scale, args.base, args.scratch)
     elif args.scop is not None:
-        scop_sensitivity(args.scop, args.tm_align, args.decoys, args.also)
+        scop_sensitivity(args.scop, args.tm_align, args.decoys, args.also, args.jobs)
     else:
         parser.error("give --scop FOLDER or --pdb-scale N")
 
