@@ -7,8 +7,8 @@ and amino acids, scored against the query's by local alignment, the best aligned
    of each residue (its backbone's geometry and that of its nearest residue in space) and its
    amino acid. The Smith–Waterman score of the query against every chain
    (:func:`alignment_scores`, :mod:`core.analysis.local_alignment`: 3Di substitution scores
-   plus :data:`AMINO_ACID_WEIGHT` times BLOSUM62, affine gaps) ranks the database, about 340
-   million cells a CPU second, and gives each chain an E-value (:func:`evalues`).
+   plus :data:`AMINO_ACID_WEIGHT` times BLOSUM62, affine gaps) ranks the database, about
+   1,150 million cells a CPU second, and gives each chain an E-value (:func:`evalues`).
 2. The :data:`ALIGNED` best, and the :data:`PROFILED` others nearest the query's profile of
    3Di state pairs, are aligned by structure: their local alignment, refined by two
    rounds of TM-align's dynamic programming on the superposed chains (:func:`refine_pairs`),
@@ -16,17 +16,17 @@ and amino acids, scored against the query's by local alignment, the best aligned
    They come first, by their fold score, the TM-score plus :data:`SCORE_SHARE` times the
    alignment score relative to the query's with itself; the others follow by score.
 
-On SCOP40's development half (Foldseek's benchmark, ``benchmarks/bench_fold_search.py``) this
-finds as many superfamilies and folds as exhaustive TM-align, and nearly all its families, at
-about 1/100 of its CPU: the cost of a query grows with the database only by its first step.
+On both halves of SCOP40 (Foldseek's benchmark, ``benchmarks/bench_fold_search.py``) this
+finds more superfamilies and folds than exhaustive TM-align, at about 1/100 to 1/200 of its
+CPU: the cost of a query grows with the database only by its first step.
 
 A query against a large index (the PDB has 800,000 chains) may spend :data:`SCORED_CELLS` cells
 of local alignment, about a CPU second (:func:`chains_scored`): the chains it scores are the
 nearest to it, half by each of the index's two summaries of a chain
 (:mod:`core.analysis.fold_index`: Carson's coarse curves and the profile of consecutive 3Di
-state pairs). For a query of 200 residues among 800,000 chains like the shared set's (200 residues
-on average), that is the 12,000 nearest by each; they keep about 85% of the family matches, 60%
-of the superfamily and 40% of the fold matches of SCOP40; neither summary knows domains.
+state pairs). For a query of 200 residues among 800,000 chains of 200 on average, that is the
+12,500 nearest by each; on SCOP40's two halves they keep 75–86% of the family matches, 60% of
+the superfamily and 36–52% of the fold matches at that scale; neither summary knows domains.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ plus a Gumbel variable of this location and scale (``scripts/train_fold_scores.p
 SCORED_CELLS = 1_000_000_000
 """Cells of local alignment (query residues × chain residues) a query may spend, about a CPU
 second: against an index of more, only the chains nearest the query are scored (:func:`chains_scored`)."""
-ALIGNED = 60
+ALIGNED = 30
 """Chains of best local alignment score that :func:`search` aligns by structure."""
 PROFILED = 10
 """Chains nearest the query's pair profile that :func:`search` aligns by structure as well,
