@@ -44,9 +44,7 @@ def local_scores(profile: np.ndarray, codes: np.ndarray, starts: np.ndarray, len
     opening, extension = np.float32(gap_open), np.float32(gap_extend)
     for group in prange((len(starts) + LANES - 1) // LANES):
         members = order[group * LANES:(group + 1) * LANES]
-        n = 0
-        for k in members:
-            n = max(n, lengths[k])
+        n = lengths[members[-1]]  # the longest: members come by length
         lane_codes = np.full((n, LANES), alphabet, dtype=np.int64)
         for lane in range(len(members)):
             k = members[lane]
