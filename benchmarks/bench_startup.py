@@ -2,10 +2,11 @@
 
 Usage: ``xvfb-run -a python benchmarks/bench_startup.py [STRUCTURE] [--runs N] [--against TREE] [--pymol]``
 (default 1UBQ). Each run starts a new Python process that runs ``ribbonwave STRUCTURE`` as a person
-starts it (``app.main.main``: the window shown at once, then the structure read and drawn), until the
-first frame with the molecule in it is drawn; it prints the time spent importing, until the window is
-on screen with its docks and its empty 3D view drawn ("window"), reading the structure and building
-its scene, and drawing that first frame, the total since the process started, and the processor time
+starts it (``app.main.main``: the window's frame shown at once, the rest of the editor loaded, then
+the structure read and drawn), until the first frame with the molecule in it is drawn; it prints the
+time spent importing, until the window is painted on screen with its menus, docks and busy bar
+("window"), loading the rest of the editor ("editor loads"), reading the structure and building its
+scene, and drawing that first frame, the total since the process started, and the processor time
 the process used: medians over the runs, after one untimed start that compiles the bytecode.
 ``--against TREE`` (another checkout of ribbonwave, e.g. a ``git worktree add`` of an earlier
 commit) times that tree's editor too, its runs taking turns with this tree's (each tree
@@ -34,24 +35,41 @@ DATA = ROOT / "tests" / "data"
 PYMOL_PHASES = {"read": "read and build"}
 """PyMOL's phases named as the editor's."""
 CHILD = """
-import json, sys, time
+import contextlib, json, sys, time
 started = float(sys.argv[2])
 t0 = time.time()
 from PySide6.QtWidgets import QApplication
-from app.editor.document import Document
+from app.editor import launch
 from app.main import main
-stamps, read = {}, Document.open
+stamps, load = {}, launch._load
+try:
+    from app.editor import busy
+except ImportError:  # (a tree without a frame shown first: "window" is when its window shows)
+    busy = None
 
-def timed_open(document, *args, **kwargs):
-    shown = [w for w in QApplication.topLevelWidgets() if w.isVisible() and hasattr(w, "plotter")]
-    if shown:  # (a tree whose window shows only with the structure: "window" is its first frame)
-        stamps["window"] = time.time()
-    stamps["frames"] = shown[0].plotter.frames if shown else 0
-    read(document, *args, **kwargs)
+def shown():
+    return [w for w in QApplication.topLevelWidgets() if w.isVisible() and hasattr(w, "menus")]
+
+if busy is not None:
+    opening = busy.opening
+
+    @contextlib.contextmanager
+    def stamped_opening(window, path):
+        with opening(window, path):  # (it paints the window before the work goes on)
+            stamps.setdefault("window", time.time())
+            yield
+    busy.opening = stamped_opening
+
+def timed_load(window, args):
+    stamps["furnished"] = time.time()
+    if shown():
+        stamps.setdefault("window", stamps["furnished"])
+    stamps["frames"] = window.plotter.frames
+    load(window, args)
     stamps["built"] = time.time()
 
 def first_frame(app):
-    window = next(w for w in QApplication.topLevelWidgets() if w.isVisible() and hasattr(w, "plotter"))
+    window = shown()[0]
     while window.plotter.frames <= stamps["frames"]:
         app.processEvents()
     stamps["drawn"], stamps["cpu"] = time.time(), time.process_time()
@@ -59,12 +77,12 @@ def first_frame(app):
     window.quit_unattended(discard=True)
     return 0
 
-import app.editor.main_window  # (timed as the imports)
 t1 = time.time()
-Document.open, QApplication.exec = timed_open, first_frame
+launch._load, QApplication.exec = timed_load, first_frame
 main([sys.argv[1]])
-print(json.dumps({"interpreter": t0 - started, "imports": t1 - t0, "window": stamps["window"] - t1,
-                  "read and build": stamps["built"] - min(stamps["window"], stamps["built"]),
+window = min(stamps["window"], stamps["furnished"])
+print(json.dumps({"interpreter": t0 - started, "imports": t1 - t0, "window": window - t1,
+                  "editor loads": stamps["furnished"] - window, "read and build": stamps["built"] - stamps["furnished"],
                   "first frame": stamps["drawn"] - stamps["built"],
                   "total": stamps["drawn"] - started, "cpu": stamps["cpu"]}))
 """
@@ -109,14 +127,15 @@ def main() -> None:
         for turn in range(args.runs):
             for times, start in list(zip(runs, starts))[:: 1 if turn % 2 == 0 else -1]:  # who goes first alternates
                 times.append(start())
-    rows = {key: [float(np.median([t[key] for t in times])) for times in runs] for key in runs[0][0]}
+    rows = {key: [float(np.median([t.get(key, np.nan) for t in times])) for times in runs] for key in runs[0][0]}
     names = ["this"] + (["against"] if args.against is not None else []) + (["PyMOL"] if args.pymol else [])
     print(f"{path.name}: start-up to the first frame with the molecule, medians of {args.runs} runs (s)")
     print(f"  {'':<15}" + "".join(f" {name:>8}" for name in names) + (f" {'ratio':>6}" if len(names) == 2 else "")
           + (f"    against: {trees[1]}" if args.against is not None else ""))
     for key, values in rows.items():
         ratio = f" {values[0] / values[1]:6.2f}" if len(values) == 2 and values[1] else ""
-        print(f"  {key:<15}" + "".join(f" {value:8.2f}" for value in values) + ratio)
+        print(f"  {key:<15}" + "".join(f" {'—':>8}" if np.isnan(value) else f" {value:8.2f}" for value in values)
+              + ratio)
 
 
 if __name__ == "__main__":

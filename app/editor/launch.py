@@ -7,19 +7,18 @@ headless commands start fast.
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import signal
 import sys
-import time
+import threading
 import traceback
-from contextlib import nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from app import DEFAULT_STRUCTURE, PROG
 from app.arguments import IMAGE_SIDE, LEVEL, SUPERSAMPLING, bounded
 from app.errors import InputError
-from core.protein.structure import StructureError
 
 if TYPE_CHECKING:
     from app.editor.main_window import MainWindow
@@ -151,7 +150,7 @@ def run_open(args: argparse.Namespace) -> int:
     # Qt and VTK load only for the window, so commands without one start fast.
     from PySide6.QtWidgets import QApplication
 
-    from app.editor.features.export import export_view
+    from app.editor import busy
     from app.editor.main_window import MainWindow
 
     if sys.platform.startswith("linux"):
@@ -160,22 +159,28 @@ def run_open(args: argparse.Namespace) -> int:
     images = [path for path in (args.screenshot, args.export_image) if path is not None]
     for path in images:
         _check_output(path, args.overwrite)
-    from app.editor.persistence.journal import checked_folder, state_folder
+    from app.editor.persistence.folder import checked_folder, state_folder
 
     try:
         checked_folder(state_folder())  # (unsaved edits are journalled there, and restored from there)
     except OSError as error:
         raise InputError(str(error)) from None
     app = QApplication.instance() or QApplication(sys.argv[:1])
-    window = MainWindow()
-    window.files.unattended = script is not None or bool(images)
-    staged = not window.files.unattended  # a person waits: the window at once, the structure once read and drawn
-    if staged:
-        window.show()
-        _draw_empty_view(window)
+    unattended = script is not None or bool(images)
+    window = MainWindow(furnish=unattended)
     try:
-        with window.files.opening(_opened_name(args)) if staged else nullcontext():
+        if unattended:
+            window.files.unattended = True
             _load(window, args)
+        else:  # a person waits: the window at once, the editor as it loads, then the structure read and drawn
+            window.show()
+            with busy.opening(window, _opened_name(args)):
+                _import_meanwhile("app.editor.window_parts")
+                if not window.isVisible():  # closed before anything was read
+                    return 0
+                window.furnish()
+                with window.files.opening(_opened_name(args)):
+                    _load(window, args)
     except InputError:
         window.close()
         raise
@@ -187,6 +192,8 @@ def run_open(args: argparse.Namespace) -> int:
         app.processEvents()  # the window laid out, as a person would first see it
         status = _run_script(window, args.script, script)
     if window.isVisible() and images:
+        from app.editor.features.export import export_view
+
         app.processEvents()  # lay the window out before it is grabbed
         try:
             if args.screenshot is not None:
@@ -216,6 +223,7 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
     from app.editor.persistence import journal, records
     from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX, SessionError
     from app.editor.scene.scene import Layer
+    from core.protein.structure import StructureError
 
     if args.recover:
         left, _ = journal.sweep(window.journal.folder)
@@ -263,25 +271,38 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
         window.comparison_panel.parentWidget().raise_()  # the dock listing them in front of its tab group
 
 
-def _draw_empty_view(window: MainWindow, seconds: float = 2.0) -> None:
-    """Let the shown window draw its 3D view (its background) before the structure is read,
-    rather than leave whatever the screen held there."""
+def _import_meanwhile(module: str) -> None:
+    """Import ``module`` in a thread while the event loop runs here: the window shown meanwhile
+    is painted (its busy bar moves) and can be moved or closed."""
     from PySide6.QtCore import QEventLoop
     from PySide6.QtWidgets import QApplication
 
-    deadline = time.monotonic() + seconds
-    window.plotter.render()
-    while window.plotter.frames == 0 and time.monotonic() < deadline:
-        QApplication.processEvents(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents, 10)
+    done, failed = threading.Event(), []
+
+    def load() -> None:
+        try:
+            importlib.import_module(module)
+        except BaseException as error:  # noqa: BLE001 (raised again in the waiting thread)
+            failed.append(error)
+        finally:
+            done.set()
+
+    threading.Thread(target=load, name=f"import {module}", daemon=True).start()
+    while not done.wait(0.02):  # (waiting releases the interpreter to the import)
+        QApplication.processEvents(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents)
+    if failed:
+        raise failed[0]
 
 
 def _opened_name(args: argparse.Namespace) -> Path:
     """What the arguments open, as its name is shown while it is read."""
-    from core.protein.assembly import assembly_path
-
     if args.recover:
         return Path("the unsaved edits")
-    return args.file if args.assembly is None else assembly_path(args.file, args.assembly)
+    if args.assembly is None:
+        return args.file
+    from core.protein.assembly import assembly_path
+
+    return assembly_path(args.file, args.assembly)
 
 
 def _check_display() -> None:

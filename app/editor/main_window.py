@@ -8,138 +8,153 @@ Each feature (:mod:`app.editor.features`: files, sessions, editing, navigation, 
 image export, help) builds its own actions and slots and puts them in the menus
 (:class:`~app.editor.features.menus.Menus`); the window only lays out the docks, keeps its
 layout between runs and closes in order.
+
+The window is built in two steps. Its frame (menus, tool bar, the docks in their places, a
+blank view) needs Qt alone and shows at once; :meth:`MainWindow.furnish` then builds the
+rest from :mod:`app.editor.window_parts`, which loads numpy, scipy, VTK and PyVista. A window
+made with ``MainWindow()`` is furnished at once; ``ribbonwave FILE`` shows the frame first
+(:func:`app.editor.launch.run_open`).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
 from PySide6.QtCore import QSettings, QSize, Qt, QTimer
 from PySide6.QtGui import QCloseEvent, QDragEnterEvent, QDropEvent, QKeySequence, QShowEvent
-from PySide6.QtWidgets import QDockWidget, QMainWindow, QUndoView, QWidget
+from PySide6.QtWidgets import QDockWidget, QMainWindow, QSizePolicy, QUndoView, QWidget
 
 from app import PROG
 from app.editor.composition import compose_once
-from app.editor.docks.comparison import ComparisonPanel
-from app.editor.docks.console import PythonConsole
 from app.editor.docks.layout import (
-    add_dock,
+    LAYOUT_KEY,
+    Pending,
     fit_frame,
     fitted,
+    new_dock,
     restore_layout,
     save_layout,
     scrolled,
     tidy_tab_bars,
 )
-from app.editor.docks.map_panel import MapPanel
-from app.editor.docks.measurements import MeasurementsPanel
-from app.editor.docks.panels import DisplayPanel, RibbonDimensionPanel
-from app.editor.docks.ramachandran import RamachandranPanel
-from app.editor.docks.sequence import SequenceBar
-from app.editor.docks.surfaces import SurfacePanel
-from app.editor.docks.validation import ValidationPanel
-from app.editor.document import Document
-from app.editor.features.clipping import Clipping
-from app.editor.features.editing import Editing
-from app.editor.features.export import ImageExport
-from app.editor.features.files import Files
-from app.editor.features.help import Help
-from app.editor.features.maps import MapsAndFits
-from app.editor.features.measuring import Measuring
 from app.editor.features.menus import Menus
-from app.editor.features.models import Models
-from app.editor.features.navigation import Navigation
-from app.editor.features.sessions import Sessions
-from app.editor.interaction.drag import DragController
-from app.editor.interaction.gestures import Gestures
-from app.editor.live_validation import LiveValidation
-from app.editor.map_correlation import LiveCorrelation
-from app.editor.persistence import journal
-from app.editor.scene.layers.validation_markers import ValidationMarkers
-from app.editor.scene.map_mesh import MapMesh
-from app.editor.scene.overlay import Comparison, ComparisonView
-from app.editor.scene.scene import Scene
-from app.editor.scene.view import new_view
-from app.editor.scripting import EditorAPI
-from app.editor.status_bar import StatusBar
-from app.editor.surfaces.layer import SurfaceLayer
+
+if TYPE_CHECKING:
+    from app.editor.document import Document
 
 DEFAULT_SIZE = QSize(1400, 900)
 """The window's first size, where the screen has room for it."""
+LEVELS_DOCK = "Ribbon dimension"
+TABBED_DOCKS = ("Display", "Surface", "Validation", "Ramachandran", "Compare", "Map", "Measurements", "History")
+"""The docks in one group of tabs under the level controls, the first in front."""
+SEQUENCE_DOCK = "Sequence"
+CONSOLE_DOCK = "Python Console"
+DOCK_AREAS = {LEVELS_DOCK: Qt.DockWidgetArea.RightDockWidgetArea,
+              **dict.fromkeys(TABBED_DOCKS, Qt.DockWidgetArea.RightDockWidgetArea),
+              SEQUENCE_DOCK: Qt.DockWidgetArea.TopDockWidgetArea, CONSOLE_DOCK: Qt.DockWidgetArea.BottomDockWidgetArea}
+"""Each dock's side of the window, in the order they are placed."""
+PENDING_SIZES = {Qt.DockWidgetArea.RightDockWidgetArea: QSize(480, 234),
+                 Qt.DockWidgetArea.TopDockWidgetArea: QSize(70, 44),
+                 Qt.DockWidgetArea.BottomDockWidgetArea: QSize(480, 200)}
+"""About the size of the panels on each side (the level controls' on the right), for the
+docks' layout while the editor loads."""
 
 
 class MainWindow(QMainWindow):
-    """The editor window on a :class:`Document` (a new, empty one when none is given)."""
+    """The editor window on a :class:`Document` (a new, empty one when none is given); with
+    ``furnish=False`` only its frame, until :meth:`furnish` builds the rest."""
 
-    def __init__(self, document: Document | None = None, parent: QWidget | None = None) -> None:
+    def __init__(self, document: Document | None = None, parent: QWidget | None = None, *,
+                 furnish: bool = True) -> None:
         super().__init__(parent)
         compose_once(self)
-        self.document = document if document is not None else Document()
-        self.document.setParent(self)
         self.settings = QSettings(PROG, PROG)
         self.resize(fitted(DEFAULT_SIZE))
         self.setAcceptDrops(True)
-        self.journal = journal.Journal(self.document)
+        self.furnished = False
+        self.menus = Menus(self)
+        blank = QWidget(autoFillBackground=True)  # where the 3D view will be, in its background colour
+        blank.setStyleSheet("background: white")
+        blank.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)  # (as the view's)
+        self.setCentralWidget(blank)
+        self.docks = self._make_docks()
+        self.console_dock = self.docks[CONSOLE_DOCK]
+        self._place_docks()
+        self._size_column(PENDING_SIZES[DOCK_AREAS[LEVELS_DOCK]])
+        restore_layout(self, self.settings)
+        if furnish:
+            self.furnish(document)
 
-        self.plotter = new_view(self)
+    def furnish(self, document: Document | None = None) -> None:
+        """Build the 3D view, the features and the docks' panels on ``document`` (a new one when
+        none is given)."""
+        import numpy as np
+
+        from app.editor import window_parts as parts
+
+        self.document = document if document is not None else parts.Document()
+        self.document.setParent(self)
+        self.journal = parts.Journal(self.document)
+
+        self.plotter = parts.new_view(self)
         self.plotter.setAcceptDrops(False)  # dropped files go to the window, which opens them
         self.plotter.iren.clear_key_event_callbacks()  # no pyvista key bindings ('q' would close the view)
         self.plotter.enable_anti_aliasing("fxaa")
         self.setCentralWidget(self.plotter)
-        self.validation = LiveValidation(self.document)  # before the scene: its report is new when the scene renders
-        self.scene = Scene(self.document, self.plotter)
-        self.markers = ValidationMarkers(self.validation, self.scene)
-        self.controller = DragController(self.document)
-        self.menus = Menus(self)
-        self.navigation = Navigation(self, self.document, self.scene, self.plotter, self.menus)
-        self.clipping = Clipping(self, self.scene, self.plotter, self.menus)
-        self.models = Models(self, self.document, self.menus)
+        self.plotter.show()  # (a widget put in a shown window stays hidden until shown: the docks took its room)
+        self.validation = parts.LiveValidation(self.document)  # before the scene: its report is new when it renders
+        self.scene = parts.Scene(self.document, self.plotter)
+        self.markers = parts.ValidationMarkers(self.validation, self.scene)
+        self.controller = parts.DragController(self.document)
+        self.navigation = parts.Navigation(self, self.document, self.scene, self.plotter, self.menus)
+        self.clipping = parts.Clipping(self, self.scene, self.plotter, self.menus)
+        self.models = parts.Models(self, self.document, self.menus)
 
-        self.dimension_panel = RibbonDimensionPanel(self.document)
+        self.dimension_panel = parts.RibbonDimensionPanel(self.document)
         self.dimension_panel.slider.valueChanged.connect(self.scene.moved)  # less detail while the level slides
         self.dimension_panel.segment.activated.connect(lambda _: (self.scene.frame_segment(), self.plotter.render()))
-        self.display_panel = DisplayPanel(self.scene)
-        self.comparison = Comparison(self.document)  # after the scene: it redraws once the scene is rebuilt
-        self.comparison_view = ComparisonView(self.comparison, self.plotter)
-        self.comparison_panel = ComparisonPanel(self.comparison)
-        self.validation_panel = ValidationPanel(self.validation)
-        self.ramachandran_panel = RamachandranPanel(self.document, self.validation)
-        self.surface_layer = SurfaceLayer(self.document, self.plotter)  # after the scene, which clears the view on load
-        self.surface_panel = SurfacePanel(self.surface_layer)
-        self.maps = MapMesh(self.document, self.plotter)  # after the scene, which clears the view on load
-        self.correlation = LiveCorrelation(self.document, self.maps)
-        self.files = Files(self, self.document, self.journal, self.settings, self.menus)
+        self.display_panel = parts.DisplayPanel(self.scene)
+        self.comparison = parts.Comparison(self.document)  # after the scene: it redraws once the scene is rebuilt
+        self.comparison_view = parts.ComparisonView(self.comparison, self.plotter)
+        self.comparison_panel = parts.ComparisonPanel(self.comparison)
+        self.validation_panel = parts.ValidationPanel(self.validation)
+        self.ramachandran_panel = parts.RamachandranPanel(self.document, self.validation)
+        self.surface_layer = parts.SurfaceLayer(self.document, self.plotter)  # after the scene, which clears the view
+        self.surface_panel = parts.SurfacePanel(self.surface_layer)
+        self.maps = parts.MapMesh(self.document, self.plotter)  # after the scene, which clears the view on load
+        self.correlation = parts.LiveCorrelation(self.document, self.maps)
+        self.files = parts.Files(self, self.document, self.journal, self.settings, self.menus)
         self.menus.add_entry("open", "Add Structures for &Comparison…", self.comparison_panel.add_dialog)
-        self.maps_and_fits = MapsAndFits(self, self.document, self.maps, self.correlation, self.comparison,
-                                         self.menus)
-        self.map_panel = MapPanel(self.maps, self.correlation, self.maps_and_fits.fit_actions)
-        self.export = ImageExport(self, self.plotter, self.files, self.menus)
-        self.sessions = Sessions(self, self.document, self.journal, self.files, self.menus, plotter=self.plotter,
-                                 scene=self.scene, display_panel=self.display_panel, comparison=self.comparison,
-                                 clipping=self.clipping)
-        self.editing = Editing(self, self.document, self.controller, self.menus)
-        self.measuring = Measuring(self, self.document, self.menus)
+        self.maps_and_fits = parts.MapsAndFits(self, self.document, self.maps, self.correlation, self.comparison,
+                                               self.menus)
+        self.map_panel = parts.MapPanel(self.maps, self.correlation, self.maps_and_fits.fit_actions)
+        self.export = parts.ImageExport(self, self.plotter, self.files, self.menus)
+        self.sessions = parts.Sessions(self, self.document, self.journal, self.files, self.menus,
+                                       plotter=self.plotter, scene=self.scene, display_panel=self.display_panel,
+                                       comparison=self.comparison, clipping=self.clipping)
+        self.editing = parts.Editing(self, self.document, self.controller, self.menus)
+        self.measuring = parts.Measuring(self, self.document, self.menus)
         self.editing.cancel_action.triggered.connect(lambda: self.measuring.use(0))  # Esc stops a tool too
-        self.measurements_panel = MeasurementsPanel(self.document)
-        self.help = Help(self, self.menus)
+        self.measurements_panel = parts.MeasurementsPanel(self.document)
+        self.help = parts.Help(self, self.menus)
         self.history = QUndoView(self.document.undo_stack)
         self.history.setUniformItemSizes(True)  # (one line a step: a history of thousands lays out at once)
         self._name_history_start()
         self.document.loaded.connect(self._name_history_start)
         self.document.history.trimmed.connect(self._name_history_start)
-        self.rw = EditorAPI(self)
+        self.rw = parts.EditorAPI(self)
         """The ``rw`` object of scripts and of the Python console."""
-        self.console = PythonConsole({"rw": self.rw, "np": np})
-        self.sequence_bar = SequenceBar(self.document)
+        self.console = parts.PythonConsole({"rw": self.rw, "np": np})
+        self.sequence_bar = parts.SequenceBar(self.document)
         self._wire_selection()
-        self._lay_out_docks()
-        self.status = StatusBar(self.statusBar(), self.document, self.controller, self.correlation)
+        self._fill_docks()
+        self.status = parts.StatusBar(self.statusBar(), self.document, self.controller, self.correlation)
         self.editing.modeChanged.connect(self.status.update)
-        self.gestures = Gestures(self.document, self.plotter, self.scene, self.controller,
-                                 select=self.navigation.select, name=self.status.labels["hover"].setText,
-                                 measure=self.measuring.click)
-        restore_layout(self, self.settings)
+        self.gestures = parts.Gestures(self.document, self.plotter, self.scene, self.controller,
+                                       select=self.navigation.select, name=self.status.labels["hover"].setText,
+                                       measure=self.measuring.click)
+        self.furnished = True
 
     def _name_history_start(self) -> None:
         """The History dock's first row: the structure as read, or where the history starts now."""
@@ -148,6 +163,9 @@ class MainWindow(QMainWindow):
 
     def quit_unattended(self, discard: bool = False) -> None:
         """Close without asking: unsaved edits are kept in the journal unless ``discard``."""
+        if not self.furnished:  # (nothing read yet)
+            self.close()
+            return
         self.files.unattended = True
         if discard:
             self.journal.discard()
@@ -164,6 +182,10 @@ class MainWindow(QMainWindow):
 
     def closeEvent(self, event: QCloseEvent) -> None:  # noqa: N802 (Qt override)
         """Ask about unsaved edits; then release the VTK render window with the window."""
+        if not self.furnished:  # closed while the editor loads: nothing to ask or release
+            save_layout(self, self.settings)
+            super().closeEvent(event)
+            return
         if not self.files.maybe_save():
             event.ignore()
             return
@@ -175,7 +197,7 @@ class MainWindow(QMainWindow):
         super().closeEvent(event)
 
     def dragEnterEvent(self, event: QDragEnterEvent) -> None:  # noqa: N802 (Qt override)
-        if any(url.isLocalFile() for url in event.mimeData().urls()):
+        if self.furnished and any(url.isLocalFile() for url in event.mimeData().urls()):
             event.acceptProposedAction()
 
     def dropEvent(self, event: QDropEvent) -> None:  # noqa: N802 (Qt override)
@@ -195,30 +217,49 @@ class MainWindow(QMainWindow):
         self.correlation.judged.connect(lambda: self.sequence_bar.strip.set_scores(
             None if self.correlation.quality is None else self.correlation.quality.residues))
 
-    def _lay_out_docks(self) -> None:
-        """The level controls at the top of the right column, the other panels in tabs under them,
-        the sequence bar above the view and the Python console (hidden) below it; each dock in
-        View ▸ too."""
+    def _make_docks(self) -> dict[str, QDockWidget]:
+        """The docks by title, each with an empty panel until the editor has loaded; each in View ▸."""
+        docks = {title: new_dock(self, title, Pending(PENDING_SIZES[area])) for title, area in DOCK_AREAS.items()}
+        console = docks[CONSOLE_DOCK]
+        console.visibilityChanged.connect(lambda: tidy_tab_bars(self))
+        self.menus.add("docks", *(dock.toggleViewAction() for dock in docks.values() if dock is not console))
+        console.toggleViewAction().setShortcut(QKeySequence("Ctrl+Shift+P"))
+        self.menus.add("console", console.toggleViewAction())
+        return docks
+
+    def _place_docks(self) -> None:
+        """The level controls at the top of the right column, the other panels in tabs under
+        them, the sequence bar above the view and the Python console (hidden) below it."""
         # the right column runs from the toolbar to the status bar; the sequence bar spans the view only
         self.setCorner(Qt.Corner.TopRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
         self.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
-        dimension = add_dock(self, "Ribbon dimension", scrolled(self.dimension_panel))
-        tabs = [add_dock(self, "Display", scrolled(self.display_panel)), add_dock(self, "Surface", self.surface_panel),
-                add_dock(self, "Validation", scrolled(self.validation_panel)),
-                add_dock(self, "Ramachandran", scrolled(self.ramachandran_panel)),
-                add_dock(self, "Compare", self.comparison_panel), add_dock(self, "Map", scrolled(self.map_panel)),
-                add_dock(self, "Measurements", self.measurements_panel), add_dock(self, "History", self.history)]
+        for title, area in DOCK_AREAS.items():
+            self.addDockWidget(area, self.docks[title])
+        self.docks[CONSOLE_DOCK].hide()
+        tabs = [self.docks[title] for title in TABBED_DOCKS]
         for dock in tabs[1:]:  # one group of tabs under the level controls: each gets the column's height
             self.tabifyDockWidget(tabs[0], dock)
         tabs[0].raise_()
-        docks: list[QDockWidget] = [dimension, *tabs,
-                                    add_dock(self, "Sequence", self.sequence_bar, Qt.DockWidgetArea.TopDockWidgetArea)]
-        self.console_dock = add_dock(self, "Python Console", self.console, Qt.DockWidgetArea.BottomDockWidgetArea)
-        self.console_dock.hide()
-        self.resizeDocks([dimension], [self.dimension_panel.sizeHint().height() + 30], Qt.Orientation.Vertical)
         tidy_tab_bars(self)
-        self.console_dock.visibilityChanged.connect(lambda: tidy_tab_bars(self))
-        self.menus.add("docks", *(dock.toggleViewAction() for dock in docks))
-        console = self.console_dock.toggleViewAction()
-        console.setShortcut(QKeySequence("Ctrl+Shift+P"))
-        self.menus.add("console", console)
+
+    def _fill_docks(self) -> None:
+        """Each panel in its dock; on a first run, the right column as wide as its widest panel asks
+        and the level controls as tall as they need."""
+        panels = {LEVELS_DOCK: scrolled(self.dimension_panel), "Display": scrolled(self.display_panel),
+                  "Surface": self.surface_panel, "Validation": scrolled(self.validation_panel),
+                  "Ramachandran": scrolled(self.ramachandran_panel), "Compare": self.comparison_panel,
+                  "Map": scrolled(self.map_panel), "Measurements": self.measurements_panel, "History": self.history,
+                  SEQUENCE_DOCK: self.sequence_bar, CONSOLE_DOCK: self.console}
+        for title, panel in panels.items():
+            self.docks[title].widget().deleteLater()
+            self.docks[title].setWidget(panel)
+        column = [dock for title, dock in self.docks.items() if DOCK_AREAS[title] == DOCK_AREAS[LEVELS_DOCK]]
+        self._size_column(QSize(max(dock.sizeHint().width() for dock in column),
+                                self.dimension_panel.sizeHint().height() + 30))
+
+    def _size_column(self, size: QSize) -> None:
+        """On a first run (no layout kept, whose sizes the person chose): the right column as wide,
+        and the level controls as tall, as ``size``."""
+        if self.settings.value(LAYOUT_KEY) is None:
+            self.resizeDocks([self.docks[LEVELS_DOCK]], [size.width()], Qt.Orientation.Horizontal)
+            self.resizeDocks([self.docks[LEVELS_DOCK]], [size.height()], Qt.Orientation.Vertical)

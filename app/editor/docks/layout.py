@@ -19,14 +19,26 @@ FRAME_ALLOWANCE = QMargins(0, 32, 0, 0)
 LAYOUT_KEY = "windowLayout"
 
 
-def add_dock(window: QMainWindow, title: str, widget: QWidget,
-             area: Qt.DockWidgetArea = Qt.DockWidgetArea.RightDockWidgetArea) -> QDockWidget:
-    """``widget`` in a new dock of ``window`` titled ``title`` (its name in the saved layout too)."""
+def new_dock(window: QMainWindow, title: str, widget: QWidget) -> QDockWidget:
+    """``widget`` in a new dock of ``window`` titled ``title`` (its name in the saved layout too),
+    to be placed with ``addDockWidget``."""
     dock = QDockWidget(title, window)
     dock.setObjectName(title)
     dock.setWidget(widget)
-    window.addDockWidget(area, dock)
     return dock
+
+
+class Pending(QWidget):
+    """An empty panel of about the size of the one that will replace it (the window lays its docks
+    out by their panels' sizes)."""
+
+    def __init__(self, hint: QSize) -> None:
+        super().__init__()
+        self.hint = hint
+
+    def sizeHint(self) -> QSize:  # noqa: N802 (Qt's name)
+        """About the size the panel to come will ask for."""
+        return self.hint
 
 
 def scrolled(widget: QWidget) -> QScrollArea:

@@ -14,20 +14,17 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import QEventLoop, Qt
 from PySide6.QtGui import QKeySequence
 from PySide6.QtWidgets import (
-    QApplication,
     QFileDialog,
     QInputDialog,
-    QLabel,
     QMainWindow,
     QMessageBox,
-    QProgressBar,
     QStyle,
 )
 
 from app import EXAMPLES_DIR, PROG
+from app.editor import busy
 from core.protein.assembly import assemblies, assembly_path
 from core.protein.structure import StructureError
 
@@ -76,24 +73,12 @@ class Files:
 
     @contextmanager
     def opening(self, path: Path) -> Iterator[None]:
-        """While ``path`` is read and drawn: its name in the title, "Opening NAME…" and a busy bar
-        at the right of the status bar and the wait cursor, all painted before the work blocks
-        the event loop."""
-        bar = self.window.statusBar()
-        note, busy = QLabel(f"Opening {path.name}…"), QProgressBar(maximumWidth=120, textVisible=False)
-        busy.setRange(0, 0)  # (no end known: the bar says only that work goes on)
-        for widget in (note, busy):
-            bar.addPermanentWidget(widget)
-        self.window.setWindowTitle(f"{path.name} — {PROG}")
-        QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)
-        QApplication.processEvents(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents)
+        """While ``path`` is read and drawn, the window busy with it (:func:`app.editor.busy.opening`);
+        then its title names the document."""
         try:
-            yield
+            with busy.opening(self.window, path):
+                yield
         finally:
-            QApplication.restoreOverrideCursor()
-            for widget in (note, busy):
-                bar.removeWidget(widget)
-                widget.deleteLater()
             self._update_title()
 
     def open_file(self, path: Path, *, raise_errors: bool = False) -> bool:

@@ -1,6 +1,6 @@
 """Crash recovery: the document's undo steps appended to a journal file as they happen.
 
-A journal lives in :func:`state_folder` from the first undo step of a structure until the
+A journal lives in :func:`~app.editor.persistence.folder.state_folder` from the first undo step of a structure until the
 document is closed cleanly (saved, or its edits discarded). It starts with the file as
 read (and where the undo history starts, once its oldest steps were dropped) and then gets one
 record per step: each new undo step as the deltas of its
@@ -28,6 +28,7 @@ from PySide6.QtCore import QObject, QTimer
 
 from app.editor.document import Document
 from app.editor.persistence import recording, records
+from app.editor.persistence.folder import checked_folder, state_folder
 
 SUFFIX = ".rwjournal"
 SET_ASIDE = ".unreadable"
@@ -40,26 +41,6 @@ SYNC_DELAY_MS = 500
 """A written record reaches the disk (fsync) this long after it was written, at most."""
 STATE_DELAY_MS = 500
 """The level and segment are journalled this long after they last changed."""
-
-
-def state_folder() -> Path:
-    """Where journals live: ``$XDG_STATE_HOME/ribbonwave`` (default ``~/.local/state/ribbonwave``)."""
-    base = os.environ.get("XDG_STATE_HOME") or str(Path.home() / ".local" / "state")
-    return Path(base) / "ribbonwave"
-
-
-def checked_folder(folder: Path) -> Path:
-    """``folder``, made private (mode 0700) if missing; raises PermissionError unless it is the
-    user's own and no one else may write in it (a journal there is restored as the user's work)."""
-    folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-    info = folder.stat()
-    if info.st_uid != os.getuid():
-        raise PermissionError(f"the folder of recovery journals {folder} belongs to another user (uid {info.st_uid}); "
-                              "set XDG_STATE_HOME to a folder of your own")
-    if info.st_mode & 0o022:
-        raise PermissionError(f"the folder of recovery journals {folder} may be written by other users (mode "
-                              f"{info.st_mode & 0o777:o}); make it yours alone: chmod go-w {folder}")
-    return folder
 
 
 class Journal(QObject):
