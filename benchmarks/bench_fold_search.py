@@ -14,7 +14,7 @@ averaged over the queries. One line per method, with the CPU seconds per query:
 - ``search``: :func:`core.analysis.fold_search.search` with its defaults (the local alignment
   of 3Di states and amino acids of every domain, the best aligned by structure), its whole
   ranking (every domain, whatever its E-value);
-- its first stage alone, the ranking by local alignment score;
+- its first stage alone, the ranking by local alignment score made fair to length;
 - the curve descriptors alone;
 - the screen of a large index (the nearest by descriptor and by pair profile, half each, as
   many as ``fold_search.SCORED_CELLS`` holds) at the scale of the PDB: per query and level, the
@@ -67,7 +67,14 @@ from core.analysis.fold_index import (
     merge,
     profile_similarities,
 )
-from core.analysis.fold_search import SCORED_CELLS, alignment_scores, query_profile, search, sensitivity
+from core.analysis.fold_search import (
+    SCORED_CELLS,
+    alignment_scores,
+    length_fair,
+    query_profile,
+    search,
+    sensitivity,
+)
 
 LEVELS = ("family", "superfamily", "fold")
 PDB_CHAINS = 800_000
@@ -159,7 +166,8 @@ def scop_sensitivity(folder: Path, tm_align_queries: int, decoys: Path | None, o
     def scored(row: int) -> np.ndarray:
         rows = slice(int(index.starts[row]), int(index.starts[row] + index.lengths[row]))
         profile = query_profile(index.states[rows], index.sequences[rows])
-        return np.argsort(-alignment_scores(index, profile, np.arange(every)), kind="stable")
+        scores = alignment_scores(index, profile, np.arange(every))
+        return np.argsort(-length_fair(scores, int(index.lengths[row]), index.lengths), kind="stable")
 
     measure("search (defaults), every domain ranked", searched, queries, labels)
     measure("its local alignment of 3Di + amino acids alone", scored, queries, labels)

@@ -85,7 +85,7 @@ def search_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--top", type=bounded(int, 1, 100000), default=TOP, metavar="K",
                         help="hits to list at most (default %(default)s)")
     parser.add_argument("--aligned", type=bounded(int, 1, 100000), default=ALIGNED, metavar="A",
-                        help="chains of best alignment score that are aligned by structure, besides the "
+                        help="chains of best alignment score (made fair to length) aligned by structure, besides the "
                         f"{PROFILED} nearest by pair profile (default %(default)s)")
     parser.add_argument("--max-evalue", type=bounded(float, 0.0, 1e9), default=MAX_EVALUE, metavar="E",
                         help="leave out hits of a larger E-value, unless their TM-score is 0.5 or more "

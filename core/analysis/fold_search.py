@@ -8,13 +8,15 @@ and amino acids, scored against the query's by local alignment, the best aligned
    amino acid. The Smith–Waterman score of the query against every chain
    (:func:`alignment_scores`, :mod:`core.analysis.local_alignment`: 3Di substitution scores
    plus :data:`AMINO_ACID_WEIGHT` times BLOSUM62, affine gaps) ranks the database, about
-   1,150 million cells a CPU second, and gives each chain an E-value (:func:`evalues`).
+   1,150 million cells a CPU second, and gives each chain an E-value (:func:`evalues`). The
+   chains rank by their score made fair to length (:func:`length_fair`), as by E-value: an
+   unrelated long chain scores higher by chance.
 2. The :data:`ALIGNED` best, and the :data:`PROFILED` others nearest the query's profile of
    3Di state pairs, are aligned by structure: their local alignment, refined by two
    rounds of TM-align's dynamic programming on the superposed chains (:func:`refine_pairs`),
    gives the TM-score, rms and identity of each (:class:`~core.analysis.compare.FoldMatch`).
    They come first, by their fold score, the TM-score plus :data:`SCORE_SHARE` times the
-   alignment score relative to the query's with itself; the others follow by score.
+   length-fair score relative to the query's with itself; the others follow by that score.
 
 On both halves of SCOP40 (Foldseek's benchmark, ``benchmarks/bench_fold_search.py``) this
 finds more superfamilies and folds than exhaustive TM-align, at less than 1/150 of its CPU:
@@ -68,9 +70,9 @@ REFINE_ROUNDS = 2
 MATCH_STEP = 8
 """The TM-score searches of the hits' matches start from fragments at every 8th pair (their
 TM-scores within 0.004 of every 4th pair's on SCOP40's development half, at less cost)."""
-SCORE_SHARE = 0.7
-"""Weight of the alignment score (relative to the query's with itself) beside the TM-score in
-the fold score that orders the chains aligned by structure."""
+SCORE_SHARE = 1.0
+"""Weight of the alignment score (:func:`length_fair`, relative to the query's with itself)
+beside the TM-score in the fold score that orders the chains aligned by structure."""
 TOP, MAX_EVALUE = 100, 10.0
 """Hits :func:`search` lists at most, and the E-value above which it leaves a hit out."""
 
@@ -115,6 +117,15 @@ def chains_scored(index: FoldIndex, query_length: int) -> int:
     return max(2, int(SCORED_CELLS * len(index) / (query_length * residues)) // 2 * 2)
 
 
+def length_fair(scores: np.ndarray, query_length: int, lengths: np.ndarray) -> np.ndarray:
+    """Local alignment ``scores`` of chains of ``lengths`` as if each were as long as the query:
+    less :data:`SCORE_SLOPE` ``ln(n / m)``, by which the scores of unrelated chains grow with
+    length (a long chain scores higher by chance). They rank as the E-values do, without their
+    ties where E-values underflow to 0 (a score of about 14,000 half bits: a large chain's own)."""
+    return (np.asarray(scores, dtype=np.float64)
+            - SCORE_SLOPE * np.log(np.asarray(lengths, dtype=np.float64) / float(query_length)))
+
+
 def evalues(scores: np.ndarray, query_length: int, lengths: np.ndarray, chains: int) -> np.ndarray:
     """The expected number of chains of unrelated folds, among ``chains``, that align to a
     query of ``query_length`` residues with a score of ``scores`` or more (chains of
@@ -151,11 +162,11 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
 
     Every chain (of a large index, the :func:`chains_scored` nearest the query, half by
     descriptor and half by pair profile) is scored by the local alignment
-    of its 3Di states and amino acids with the query's. The best ``aligned``, and the
-    :data:`PROFILED` others nearest the query's pair profile, are aligned by structure and
-    come first, by their fold score: the TM-score (normalised by the query) plus
-    :data:`SCORE_SHARE` times the alignment score relative to the query's with itself. The rest
-    follow by score.
+    of its 3Di states and amino acids with the query's. The best ``aligned`` by that score
+    made fair to length (:func:`length_fair`), and the :data:`PROFILED` others nearest the
+    query's pair profile, are aligned by structure and come first, by their fold score: the
+    TM-score (normalised by the query) plus :data:`SCORE_SHARE` times the length-fair score
+    relative to the query's with itself. The rest follow by the length-fair score.
 
     Parameters
     ----------
@@ -177,7 +188,8 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
     own = float(local_scores(profile, residue_codes(query_states, names), np.zeros(1, np.int64),
                              np.array([len(ca)]), GAP_OPEN, GAP_EXTEND)[0])
     expected = evalues(scores, len(ca), index.lengths[rows], len(index))
-    order = np.argsort(-scores, kind="stable")
+    fair = length_fair(scores, len(ca), index.lengths[rows])
+    order = np.argsort(-fair, kind="stable")
     chosen = order[:aligned].tolist()
     taken = set(chosen)
     chosen += [k for k in np.argsort(-similarity[rows], kind="stable")[:aligned + PROFILED].tolist()
@@ -192,7 +204,7 @@ def search(index: FoldIndex, ca: np.ndarray, sequence: str, top: int = TOP, alig
             pairs_a, pairs_b = refine_pairs(ca, other, pairs_a, pairs_b, REFINE_ROUNDS)
         if len(pairs_a) >= MIN_PAIRS:
             matches[k] = fold_match(ca, other, pairs_a, pairs_b, names, other_names, MATCH_STEP)
-            fold_scores[k] = matches[k].tm_score_a + SCORE_SHARE * float(scores[k]) / max(own, 1.0)
+            fold_scores[k] = matches[k].tm_score_a + SCORE_SHARE * float(fair[k]) / max(own, 1.0)
     ranked = sorted(fold_scores, key=lambda k: -fold_scores[k]) + [k for k in order.tolist() if k not in fold_scores]
     hits = []
     for k in ranked:

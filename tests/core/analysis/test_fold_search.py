@@ -19,7 +19,7 @@ from core.analysis.fold_index import (
     merge,
     profile_similarities,
 )
-from core.analysis.fold_search import chains_scored, evalues, search, sensitivity
+from core.analysis.fold_search import chains_scored, evalues, length_fair, search, sensitivity
 from core.analysis.local_alignment import LANES, local_pairs, local_scores
 from core.curves.wavelets import smooth
 
@@ -118,6 +118,24 @@ def test_local_alignment_scores_and_pairs_agree_and_evalues_fall_with_score() ->
         assert total == pytest.approx(best, rel=1e-5) and (np.diff(pairs_a) > 0).all() and (np.diff(pairs_b) > 0).all()
     low, high = evalues(np.array([50.0, 150.0]), 100, np.array([120, 120]), 1000)
     assert 0 < high < low <= 1000
+
+
+def test_chains_rank_by_their_length_fair_score_as_by_their_evalue() -> None:
+    """A chain as long as the query keeps its score; a longer one, whose score an unrelated chain
+    reaches more easily by chance, ranks behind a shorter one of the same score, and the order
+    is the E-values', also where they are too small to tell apart."""
+    rng = np.random.default_rng(11)
+    scores = np.concatenate([rng.uniform(0.0, 400.0, 2000), rng.uniform(15_000.0, 20_000.0, 50)])  # (large chains' self-matches)
+    lengths = rng.integers(5, 3000, len(scores))
+    fair = length_fair(scores, 150, lengths)
+    assert length_fair(np.array([80.0]), 150, np.array([150]))[0] == 80.0
+    assert np.all(np.diff(fair[np.argsort(-scores)][lengths[np.argsort(-scores)] == 150]) <= 0)
+    longer, shorter = length_fair(np.array([120.0, 120.0]), 150, np.array([600, 75]))
+    assert longer < 120.0 < shorter
+    expected = evalues(scores, 150, lengths, 1_000_000)
+    ranked = expected[np.argsort(-fair, kind="stable")]
+    assert np.all(np.diff(ranked) >= 0) and np.sum(expected == 0.0) > 10  # E-values of 0 tie; fair scores do not
+    assert len(np.unique(fair[expected == 0.0])) == np.sum(expected == 0.0)
 
 
 def test_the_index_file_round_trip_and_refusals(index, tmp_path) -> None:
