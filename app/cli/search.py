@@ -101,8 +101,10 @@ def run_search(args: argparse.Namespace) -> int:
     if not segments:
         chains = ", ".join(dict.fromkeys(s.chain for s in structure.segments))
         raise InputError(f"{path}: no protein chain {chain!r} (chains: {chains})")
-    if sum(len(s) for s in segments) < 3:
-        raise InputError(f"{path}: chain {chain} has fewer than 3 residues")
+    residues = sum(len(s) for s in segments)
+    if residues < MIN_RESIDUES:  # (its TM-scores and E-values would mean little; the index holds none either)
+        raise InputError(f"{path}: chain {chain} has {residues} residue(s): a fold search needs a chain of "
+                         f"{MIN_RESIDUES} or more (a peptide has no fold to search)")
     if not args.index.is_file():
         raise InputError(f"{args.index}: no such file")
     try:

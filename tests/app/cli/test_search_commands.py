@@ -5,6 +5,7 @@ import json
 import shutil
 from pathlib import Path
 
+import gemmi
 import numpy as np
 import pytest
 
@@ -106,6 +107,21 @@ def test_an_index_is_never_overwritten_unless_asked(folder, tmp_path, capsys):
     status, _, _ = run(capsys, "index", folder / "1UBQ.pdb.gz", "-o", target, "--jobs", "1", "--overwrite")
     assert status == 0 and len(read_index(target)) == 1
     assert [p.name for p in tmp_path.iterdir()] == ["folds.npz"]  # no temporary file left
+
+
+def test_a_peptide_is_refused_as_a_query(index_file, tmp_path, capsys):
+    """A query of fewer than 20 residues (none such is indexed) is refused, saying why: its
+    TM-scores and E-values mean little (ubiquitin's first 5 residues matched 16 chains of the
+    README's index at a TM-score of 0.5 or more). The Trp-cage's 20 residues are searched."""
+    structure = gemmi.read_structure(str(DATA / "1UBQ.pdb.gz"))
+    chain = structure[0]["A"]
+    for k in range(len(chain) - 1, 11, -1):
+        del chain[k]
+    structure.write_pdb(str(tmp_path / "peptide.pdb"))
+    status, _, err = run(capsys, "search", tmp_path / "peptide.pdb", index_file)
+    assert status == 1 and "chain A has 12 residue(s): a fold search needs a chain of 20 or more" in err
+    status, out, _ = run(capsys, "search", DATA / "1L2Y.pdb.gz", index_file)
+    assert status == 0 and "chain A (20 residues)" in out
 
 
 @pytest.mark.parametrize(
