@@ -131,8 +131,8 @@ def evalues(scores: np.ndarray, query_length: int, lengths: np.ndarray, chains: 
     query of ``query_length`` residues with a score of ``scores`` or more (chains of
     ``lengths``): a Gumbel tail whose location grows with ``ln(m n)`` (:data:`SCORE_SLOPE`,
     :data:`SCORE_LOCATION`, :data:`SCORE_SCALE`, fitted on unrelated chains)."""
-    shift = (np.asarray(scores, dtype=np.float64) - SCORE_SLOPE * np.log(float(query_length) * lengths)
-             - SCORE_LOCATION) / SCORE_SCALE
+    chance = SCORE_SLOPE * 2.0 * np.log(float(query_length)) + SCORE_LOCATION  # (a chain of the query's length)
+    shift = (length_fair(scores, query_length, lengths) - chance) / SCORE_SCALE
     return chains * -np.expm1(-np.exp(-shift))
 
 

@@ -1,16 +1,16 @@
 """Crash recovery: the document's undo steps appended to a journal file as they happen.
 
-A journal lives in :func:`~app.editor.persistence.folder.state_folder` from the first undo step of a structure until the
-document is closed cleanly (saved, or its edits discarded). It starts with the file as
-read (and where the undo history starts, once its oldest steps were dropped) and then gets one
-record per step: each new undo step as the deltas of its
-:class:`~core.protein.model.Edit`, each undo or redo as the new stack position, and the
-level and segment shortly after they change (:mod:`app.editor.persistence.records`). Every record goes
-to the operating system at once, so a kill loses at most the step being written, and to
-the disk within :data:`SYNC_DELAY_MS` (in a background thread). A running editor holds a
-lock on its journal; a journal nobody holds was left by a crash (:func:`orphans`). On a save,
-and when the history drops its oldest steps, the journal is rewritten as the history then is,
-so that it grows no larger than the history.
+A journal lives in :func:`~app.editor.persistence.folder.state_folder` from the first undo
+step of a structure until the document is closed cleanly (saved, or its edits discarded). It
+starts with the file as read (and where the undo history starts, once its oldest steps were
+dropped) and then gets one record per step: each new undo step as the deltas of its
+:class:`~core.protein.model.Edit`, each undo or redo as the new stack position, and the level
+and segment shortly after they change (:mod:`app.editor.persistence.records`). Every record goes
+to the operating system at once, so a kill loses at most the step being written, and to the
+disk within :data:`SYNC_DELAY_MS` (in a background thread). A running editor holds a lock on
+its journal; a journal nobody holds was left by a crash (:func:`orphans`). On a save, and when
+the history drops its oldest steps, the journal is rewritten as the history then is, so that
+it grows no larger than the history.
 """
 
 from __future__ import annotations
