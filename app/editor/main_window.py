@@ -54,11 +54,10 @@ DOCK_AREAS = {LEVELS_DOCK: Qt.DockWidgetArea.RightDockWidgetArea,
               **dict.fromkeys(TABBED_DOCKS, Qt.DockWidgetArea.RightDockWidgetArea),
               SEQUENCE_DOCK: Qt.DockWidgetArea.TopDockWidgetArea, CONSOLE_DOCK: Qt.DockWidgetArea.BottomDockWidgetArea}
 """Each dock's side of the window, in the order they are placed."""
-PENDING_SIZES = {Qt.DockWidgetArea.RightDockWidgetArea: QSize(480, 234),
-                 Qt.DockWidgetArea.TopDockWidgetArea: QSize(70, 44),
-                 Qt.DockWidgetArea.BottomDockWidgetArea: QSize(480, 200)}
-"""About the size of the panels on each side (the level controls' on the right), for the
-docks' layout while the editor loads."""
+PENDING_SIZES = {LEVELS_DOCK: QSize(480, 234), **dict.fromkeys(TABBED_DOCKS, QSize(480, 600)),
+                 SEQUENCE_DOCK: QSize(70, 44), CONSOLE_DOCK: QSize(480, 200)}
+"""About the size of each dock's panel, for the docks' layout while the editor loads (the tabs
+under the level controls take the rest of the column)."""
 
 
 class MainWindow(QMainWindow):
@@ -81,7 +80,7 @@ class MainWindow(QMainWindow):
         self.docks = self._make_docks()
         self.console_dock = self.docks[CONSOLE_DOCK]
         self._place_docks()
-        self._size_column(PENDING_SIZES[DOCK_AREAS[LEVELS_DOCK]])
+        self._size_column(PENDING_SIZES[LEVELS_DOCK])
         restore_layout(self, self.settings)
         if furnish:
             self.furnish(document)
@@ -219,7 +218,7 @@ class MainWindow(QMainWindow):
 
     def _make_docks(self) -> dict[str, QDockWidget]:
         """The docks by title, each with an empty panel until the editor has loaded; each in View ▸."""
-        docks = {title: new_dock(self, title, Pending(PENDING_SIZES[area])) for title, area in DOCK_AREAS.items()}
+        docks = {title: new_dock(self, title, Pending(PENDING_SIZES[title])) for title in DOCK_AREAS}
         console = docks[CONSOLE_DOCK]
         console.visibilityChanged.connect(lambda: tidy_tab_bars(self))
         self.menus.add("docks", *(dock.toggleViewAction() for dock in docks.values() if dock is not console))
