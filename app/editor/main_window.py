@@ -39,9 +39,12 @@ from app.editor.docks.layout import (
     tidy_tab_bars,
 )
 from app.editor.features.menus import Menus
+from app.editor.source_reads import forget_sources_read_by_pyside
 
 if TYPE_CHECKING:
     from app.editor.document import Document
+
+forget_sources_read_by_pyside()  # before the window's parts are imported
 
 DEFAULT_SIZE = QSize(1400, 900)
 """The window's first size, where the screen has room for it."""

@@ -44,10 +44,10 @@ class Measurement:
 
     def names(self, structure: Structure) -> str:
         """The atoms' names, joined by dashes: ``A:LYS48 NZ – A:GLU50 OE1``."""
-        labels = topology(structure).atom_labels
+        label = topology(structure).atom_label
         if self.residue:
-            return str(labels[self.atoms[0]]).rsplit(" ", 1)[0]
-        return " – ".join(str(labels[row]) for row in self.atoms)
+            return label(self.atoms[0]).rsplit(" ", 1)[0]
+        return " – ".join(label(row) for row in self.atoms)
 
     def record(self) -> dict:
         """What a session keeps of it."""

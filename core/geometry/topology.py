@@ -13,7 +13,7 @@ from scipy.spatial import cKDTree
 
 from core.geometry.ideal import BOND_SLACK, COVALENT_RADIUS, POLAR_CONTACT, VDW_RADIUS
 from core.geometry.vectors import dihedral, distance
-from core.protein.structure import Structure
+from core.protein.structure import AtomTable, Structure
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,8 +44,9 @@ class Topology:
         Keys ``i * n_atoms + j`` (i < j) of atom pairs at most three bonds apart.
     conformer : (n_atoms,) int64
         Alternate location as a number, 0 where none.
-    atom_labels : (n_atoms,) str
-        Label ('A:LYS48 NZ') of every atom.
+    atoms : AtomTable
+        The structure's atoms, and ``atom_residue`` their residue-table rows, -1 if none (for
+        :meth:`atom_label`).
     """
 
     backbone: np.ndarray
@@ -60,11 +61,19 @@ class Topology:
     polar: np.ndarray
     excluded: np.ndarray
     conformer: np.ndarray = field(repr=False)
-    atom_labels: np.ndarray = field(repr=False)
+    atoms: AtomTable = field(repr=False)
+    atom_residue: np.ndarray = field(repr=False)
 
     @property
     def n_atoms(self) -> int:
         return len(self.radius)
+
+    def atom_label(self, row: int) -> str:
+        """Label of atom ``row``: its residue's (``A:LYS48``; of a ligand or water ``A:HOH301``),
+        its name, and its alternate location after a dot (``A:SER65 OG.B``)."""
+        atoms, owner = self.atoms, int(self.atom_residue[row])
+        residue = self.labels[owner] if owner >= 0 else f"{atoms.chain[row]}:{atoms.resname[row]}{atoms.resseq[row]}"
+        return f"{residue} {atoms.name[row]}" + (f".{atoms.altloc[row]}" if atoms.altloc[row] else "")
 
     def around(self, rows: np.ndarray) -> Topology:
         """This topology with only the excluded pairs that have an atom in ``rows``: enough
@@ -134,7 +143,6 @@ def topology(structure: Structure) -> Topology:
     checked = (radius > 0) & (atoms.category != "water")
     radius[~checked] = 0.0
     polar = np.isin(atoms.element, ("N", "O"))
-    atom_labels = _atom_labels(structure, labels)
     return Topology(
         backbone=backbone,
         labels=labels,
@@ -148,7 +156,8 @@ def topology(structure: Structure) -> Topology:
         polar=polar,
         excluded=_excluded_pairs(structure, backbone, first, second, checked),
         conformer=np.unique(np.append(atoms.altloc, ""), return_inverse=True)[1][:-1],  # '' sorts first: 0
-        atom_labels=atom_labels,
+        atoms=atoms,
+        atom_residue=structure.atom_residue,
     )
 
 
@@ -173,17 +182,6 @@ def _junction_dihedral(coords: np.ndarray, backbone: np.ndarray, first: np.ndarr
     xyz = np.where((quad >= 0)[..., None], coords[quad.clip(min=0)], np.nan)
     with np.errstate(invalid="ignore"):
         return dihedral(xyz[:, 0], xyz[:, 1], xyz[:, 2], xyz[:, 3])
-
-
-def _atom_labels(structure: Structure, residue_labels: np.ndarray) -> np.ndarray:
-    atoms, owner = structure.atoms, structure.atom_residue
-    residue = np.where(
-        owner >= 0,
-        residue_labels[owner.clip(min=0)],
-        np.char.add(np.char.add(np.char.add(atoms.chain, ":"), atoms.resname), atoms.resseq.astype(str)),
-    )
-    alt = np.where(atoms.altloc != "", np.char.add(".", atoms.altloc), "")
-    return np.char.add(np.char.add(np.char.add(residue, " "), atoms.name), alt)
 
 
 def _excluded_pairs(

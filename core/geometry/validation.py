@@ -297,7 +297,7 @@ def _clash_flags(
         a, b = int(i[k]), int(j[k])
         overlap = contact[k] - d[k]
         flags.append(Flag(
-            "clash", f"{top.atom_labels[a]} / {top.atom_labels[b]}", float(d[k]), float(contact[k]),
+            "clash", f"{top.atom_label(a)} / {top.atom_label(b)}", float(d[k]), float(contact[k]),
             float(overlap / CLASH_OVERLAP), tuple((0.5 * (coords[a] + coords[b])).tolist()),
             tuple(int(r) for r in (atom_residue[a], atom_residue[b]) if r >= 0),
             f"{d[k]:.2f} Å apart, overlap {overlap:.2f} Å",

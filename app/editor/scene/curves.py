@@ -22,22 +22,27 @@ from core.protein.ribbon import Ribbon
 
 RINGS_PER_RESIDUE = 6
 """Tube rings per residue (the thin level curve has half as many samples)."""
+SIDES = 12
+"""Vertices around each ring of the tube and the cartoon."""
 LARGE_RESIDUES = 10_000
 """Residues above which a structure (a capsid, an assembly) is swept with
-:data:`LARGE_RINGS_PER_RESIDUE` rings a residue: a third fewer vertices to hold and to draw."""
+:data:`LARGE_RINGS_PER_RESIDUE` rings a residue of :data:`LARGE_SIDES` vertices: less than half
+the vertices and triangles to hold and to draw, where a residue takes a few pixels."""
 LARGE_RINGS_PER_RESIDUE = 4
+LARGE_SIDES = 8
 
 
-def rings_per_residue(n_residues: int) -> int:
-    """Tube rings per residue for a structure of ``n_residues`` residues in all its segments."""
-    return RINGS_PER_RESIDUE if n_residues <= LARGE_RESIDUES else LARGE_RINGS_PER_RESIDUE
+def sampling(n_residues: int) -> tuple[int, int]:
+    """Tube rings per residue, and vertices around each ring, for a structure of ``n_residues``
+    residues in all its segments."""
+    return (RINGS_PER_RESIDUE, SIDES) if n_residues <= LARGE_RESIDUES else (LARGE_RINGS_PER_RESIDUE, LARGE_SIDES)
 
 
 def segment_paths(ribbons: list[Ribbon]) -> list[SegmentPath]:
-    """The sampling of every segment of a structure with these ``ribbons``, as many rings a
-    residue as its size allows (:func:`rings_per_residue`)."""
-    rings = rings_per_residue(sum(len(ribbon.residue_u) for ribbon in ribbons))
-    return [SegmentPath(ribbon, rings) for ribbon in ribbons]
+    """The sampling of every segment of a structure with these ``ribbons``, as fine as its size
+    allows (:func:`sampling`)."""
+    rings, sides = sampling(sum(len(ribbon.residue_u) for ribbon in ribbons))
+    return [SegmentPath(ribbon, rings, sides) for ribbon in ribbons]
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,14 +86,16 @@ class SegmentPath:
     ----------
     ribbon : the segment's ribbon (only its layout is used; its points may change later).
     rings_per_residue : tube rings per residue, even.
+    sides : vertices around each ring of a tube swept along it.
     """
 
-    def __init__(self, ribbon: Ribbon, rings_per_residue: int = RINGS_PER_RESIDUE) -> None:
+    def __init__(self, ribbon: Ribbon, rings_per_residue: int = RINGS_PER_RESIDUE, sides: int = SIDES) -> None:
         n_residues = len(ribbon.residue_u)
         half = 0.5 / 2**ribbon.level
         steps = np.arange(n_residues * rings_per_residue + 1)
         self.finest = ribbon.level
         self.rings_per_residue = rings_per_residue
+        self.sides = sides
         self.residue_u = ribbon.residue_u
         self.u = np.clip(ribbon.residue_u[0] - half + steps * (2 * half / rings_per_residue), 0.0, 1.0)
         """(R,) ring parameters, ``R = N * rings_per_residue + 1``."""

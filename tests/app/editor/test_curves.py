@@ -8,9 +8,11 @@ import pytest
 from app.editor.scene.curves import (
     LARGE_RESIDUES,
     LARGE_RINGS_PER_RESIDUE,
+    LARGE_SIDES,
     RINGS_PER_RESIDUE,
+    SIDES,
     SegmentPath,
-    rings_per_residue,
+    sampling,
 )
 from core.curves.splines import spline_space
 from core.protein.reading import read_structure
@@ -81,7 +83,8 @@ def test_tangents_at_a_curve_end_over_doubled_control_points() -> None:
     assert tangents[0] @ (centres[1] - centres[0]) > 0 and tangents[3] @ (centres[3] - centres[2]) > 0
 
 
-def test_a_large_structure_is_swept_with_fewer_rings() -> None:
-    """A capsid's 11,040 residues (2BUK's assembly) take 4 rings a residue, ubiquitin's 76 take 6."""
-    assert rings_per_residue(76) == rings_per_residue(LARGE_RESIDUES) == RINGS_PER_RESIDUE == 6
-    assert rings_per_residue(LARGE_RESIDUES + 1) == rings_per_residue(11_040) == LARGE_RINGS_PER_RESIDUE == 4
+def test_a_large_structure_is_swept_with_fewer_rings_of_fewer_vertices() -> None:
+    """A capsid's 11,040 residues (2BUK's assembly) take 4 rings a residue of 8 vertices, ubiquitin's
+    76 take 6 of 12."""
+    assert sampling(76) == sampling(LARGE_RESIDUES) == (RINGS_PER_RESIDUE, SIDES) == (6, 12)
+    assert sampling(LARGE_RESIDUES + 1) == sampling(11_040) == (LARGE_RINGS_PER_RESIDUE, LARGE_SIDES) == (4, 8)

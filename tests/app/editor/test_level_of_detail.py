@@ -11,7 +11,8 @@ from PySide6.QtWidgets import QApplication
 from pytestqt.qtbot import QtBot
 
 from app.editor.main_window import MainWindow
-from app.editor.scene.layers.swept import MOVING_RING_STEP, MOVING_SIDE_STEP, SIDES
+from app.editor.scene.curves import SIDES
+from app.editor.scene.layers.swept import MOVING_RING_STEP, MOVING_SIDE_STEP
 from app.editor.scene.scene import STILL_AFTER_MS, Layer
 
 Opener = Callable[[str], MainWindow]

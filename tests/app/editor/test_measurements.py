@@ -47,9 +47,11 @@ def test_a_distance_picked_with_the_mouse_follows_a_drag(open_window: Opener, qt
     document.set_regularization(on_release=False)
     window.display_panel.layer_boxes[Layer.ATOMS].setChecked(True)
     window.display_panel.layer_boxes[Layer.CONTROL_POINTS].setChecked(False)  # (no sphere in front of an atom)
-    names = document.structure.atoms.name
-    first = int(np.flatnonzero((document.structure.atom_residue == 47) & (names == "NZ"))[0])  # Lys48 NZ
-    second = int(np.flatnonzero((document.structure.atom_residue == 5) & (names == "NZ"))[0])  # Lys6 NZ
+    atoms = document.structure.atoms
+    lysines = np.flatnonzero((atoms.resname == "LYS") & (atoms.name == "NZ"))
+    towards = -np.array(window.plotter.camera.GetDirectionOfProjection())
+    first, second = map(int, lysines[np.argsort(document.model.coords[lysines] @ towards)[::-1][:2]])  # the frontmost
+    residue = int(document.structure.atom_residue[first])
     window.measuring.tools.actions()[1].trigger()  # View ▸ Measure Distance
     assert window.statusBar().currentMessage() == "Distance: click atom 1 of 2 (Esc stops)"
     _click(window, document.model.coords[first])
@@ -59,12 +61,14 @@ def test_a_distance_picked_with_the_mouse_follows_a_drag(open_window: Opener, qt
     assert len(items) == 1 and items[0].atoms == (first, second) and len(document.selection) == 0
     expected = _position(document.model.coords, first).dist(_position(document.model.coords, second))
     table = window.measurements_panel.table
-    assert table.rowCount() == 1 and table.item(0, 1).text() == "A:LYS48 NZ – A:LYS6 NZ"
+    assert table.rowCount() == 1
+    assert table.item(0, 1).text() == f"A:LYS{atoms.resseq[first]} NZ – A:LYS{atoms.resseq[second]} NZ"
     assert table.item(0, 2).text() == _texts(window)[0] == f"{expected:.2f} Å"
 
-    window.rw.tug(47, (3.0, 0.0, 0.0))  # Lys48 moves: the value follows in the view and the dock
+    before = document.model.coords[first].copy()
+    window.rw.tug(residue, (3.0, 0.0, 0.0))  # the first lysine moves: the value follows in the view and the dock
     moved = _position(document.model.coords, first).dist(_position(document.model.coords, second))
-    assert abs(moved - expected) > 0.5
+    assert np.linalg.norm(document.model.coords[first] - before) > 1.0 and f"{moved:.2f}" != f"{expected:.2f}"
     assert table.item(0, 2).text() == _texts(window)[0] == f"{moved:.2f} Å"
     lines = np.asarray(window.scene.meshes["measure_lines"].points)
     np.testing.assert_allclose(lines, document.model.coords[[first, second]], atol=1e-4)
@@ -76,7 +80,7 @@ def test_a_distance_picked_with_the_mouse_follows_a_drag(open_window: Opener, qt
     qtbot.keyClick(window.plotter, Qt.Key.Key_Escape)  # the tool stops: a click selects again
     assert window.measuring.wanted == 0
     _click(window, document.model.coords[first])
-    assert len(document.measurements.items) == 1 and list(document.selection) == [47]
+    assert len(document.measurements.items) == 1 and list(document.selection) == [residue]
 
 
 def test_labels_angles_and_dihedrals_from_rw_are_gemmis_and_come_back_with_the_session(
@@ -115,6 +119,9 @@ def test_a_residue_clicked_with_the_label_tool_is_labelled(open_window: Opener) 
     window.display_panel.layer_boxes[Layer.CONTROL_POINTS].setChecked(False)
     window.measuring.tools.actions()[0].trigger()  # View ▸ Label
     assert window.statusBar().currentMessage() == "Label: click an atom (Esc stops)"
-    _click(window, document.model.coords[document.ca_rows[47]])
-    assert window.rw.measurements == ["A:LYS48"] and _texts(window) == ["A:LYS48"]
+    towards = -np.array(window.plotter.camera.GetDirectionOfProjection())
+    front = int(np.argmax(document.model.coords[document.ca_rows] @ towards))  # the frontmost: nothing hides it
+    _click(window, document.model.coords[document.ca_rows[front]])
+    label = document.structure.segments[0].labels[front]
+    assert window.rw.measurements == [label] and _texts(window) == [label]
     assert window.measuring.wanted == 1  # still labelling

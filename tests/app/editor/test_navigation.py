@@ -14,7 +14,8 @@ from pytestqt.qtbot import QtBot
 from app.editor.interaction.drag import HANDLE_BOX, HANDLE_RADIUS
 from app.editor.main_window import MainWindow
 from app.editor.scene.layers.control_points import MIN_POINT_PIXELS
-from app.editor.scene.layers.tube import TUBE_SIDES, TubeLayer
+from app.editor.scene.curves import SIDES
+from app.editor.scene.layers.tube import TubeLayer
 from app.editor.scene.scene import Layer, Others
 
 Opener = Callable[[str], MainWindow]
@@ -93,13 +94,17 @@ def test_hovering_names_the_residue_the_point_and_the_atom(window: MainWindow, q
     window.scene.set_layer(Layer.CONTROL_POINTS, False)
     window.scene.set_layer(Layer.ATOMS, True)
     table = document.structure.atoms
-    nz = int(np.flatnonzero((table.resname == "LYS") & (table.name == "NZ"))[0])
+    lysines = np.flatnonzero((table.resname == "LYS") & (table.name == "NZ"))
+    towards = -np.array(window.plotter.camera.GetDirectionOfProjection())
+    nz = int(lysines[np.argmax(document.model.coords[lysines] @ towards)])  # the frontmost: nothing hides it
     window.scene.centre_on(document.model.coords[nz])
     window.plotter.camera.zoom(4.0)
     window.plotter.render()
     _move(window, _display(window, document.model.coords[nz]))
     assert window.status.labels["hover"].text().split(" · ")[0] == f"{document.structure.residue_label(table.residue[nz])} NZ"
 
+    window.scene.reset_camera()
+    window.plotter.render()
     _move(window, (2, 2))  # the corner: nothing
     assert window.status.labels["hover"].text() == ""
 
@@ -303,7 +308,7 @@ def test_other_chains_dimmed_hidden_and_shown(open_window: Opener) -> None:
     rings = window.scene.part(TubeLayer).ring_start
     chains = [s.chain for s in document.structure.segments]
     k = next(k for k, chain in enumerate(chains) if chain != chains[document.segment])
-    edited, other = (slice(rings[g] * TUBE_SIDES, rings[g + 1] * TUBE_SIDES) for g in (document.segment, k))
+    edited, other = (slice(rings[g] * SIDES, rings[g + 1] * SIDES) for g in (document.segment, k))
     colours = np.array(tube.point_data["colours"])
     assert colours[other].min() > colours[edited].min() + 60  # faded toward white
     points = np.array(tube.points)

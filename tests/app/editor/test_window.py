@@ -22,7 +22,7 @@ from app.editor.features.files import RECENT_KEY
 from app.editor.interaction.drag import Mode
 from app.editor.main_window import MainWindow
 from app.editor.scene import molecule
-from app.editor.scene.layers.tube import TUBE_SIDES
+from app.editor.scene.curves import SIDES
 from app.editor.scene.molecule import Colouring
 from app.editor.scene.scene import Layer
 from app.main import COMMANDS, main
@@ -109,7 +109,7 @@ def test_bundled_example_is_ubiquitin(qapp: QApplication) -> None:
 def test_window_shows_the_structure(window: MainWindow) -> None:
     assert window.windowTitle() == "1UBQ.pdb.gz[*] — ribbonwave" and not window.isWindowModified()
     cartoon = window.scene.meshes["cartoon"]
-    assert cartoon.n_points == (76 * 6 + 1) * TUBE_SIDES + 2 * (TUBE_SIDES + 1)
+    assert cartoon.n_points == (76 * 6 + 1) * SIDES + 2 * (SIDES + 1)
     assert window.plotter.actors["cartoon"].GetVisibility() and "tube" not in window.plotter.actors  # (until shown)
     colours = {tuple(c) for c in cartoon.point_data["colours"]}
     assert set(molecule.SS_COLOURS.values()) <= colours
@@ -196,7 +196,7 @@ def test_layers_colours_and_fat_helices(window: MainWindow) -> None:
     helix = np.flatnonzero(window.document.structure.segments[0].ss == "H")[3]  # a residue inside the helix
     ring = helix * centre.rings_per_residue + centre.rings_per_residue // 2
     centres, _ = centre.centres(window.document.model.ribbons[0].points, np.array([ring]))
-    radius = np.linalg.norm(tube.points[ring * TUBE_SIDES] - centres[0])
+    radius = np.linalg.norm(tube.points[ring * SIDES] - centres[0])
     assert radius == pytest.approx(1.5, abs=1e-4) and not np.allclose(before, tube.points)
 
 

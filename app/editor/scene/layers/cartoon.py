@@ -13,7 +13,7 @@ from app.editor.scene import cartoon, tube
 from app.editor.scene.layers.base import Layer
 from app.editor.scene.layers.chains import Others
 from app.editor.scene.layers.meshes import Rows
-from app.editor.scene.layers.swept import SIDES, SweptLayer
+from app.editor.scene.layers.swept import SweptLayer
 from core.geometry.topology import topology
 
 
@@ -97,5 +97,5 @@ class CartoonLayer(SweptLayer):
         guides = cartoon.smoothed(guides * self._signs[segment][low:high], window)
         along = cartoon.ring_guides(guides, k, index, low, n)
         points, normals = cartoon.section_vertices(centres, tangents, along, tube.perpendicular(tangents),
-                                                   self._shapes[segment][index], SIDES)
+                                                   self._shapes[segment][index], self.sides)
         return centres, tangents, points, normals

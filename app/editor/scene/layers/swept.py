@@ -24,8 +24,6 @@ from app.editor.scene.layers.base import SceneLayer, Stage
 from app.editor.scene.layers.chains import Others
 from app.editor.scene.layers.meshes import Rows, cells, collapse, compact, shift, span
 
-SIDES = 12
-"""Vertices per ring."""
 MOVING_RING_STEP = 3
 MOVING_SIDE_STEP = 2
 """While something moves, the segments not edited keep every third ring and every other side
@@ -49,22 +47,29 @@ class SweptLayer(SceneLayer):
         self._stale = False
         """Whether the mesh missed changes while hidden."""
 
+    @property
+    def sides(self) -> int:
+        """Vertices around each ring, as the segments' paths are sampled (all alike)."""
+        return self.document.paths[0].sides
+
     def rings(self, segment: int, rings: Rows) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The centres (r, 3) and unit tangents (r, 3) of ``rings`` of ``segment``, and their
-        vertices and vertex normals (r * :data:`SIDES`, 3), ring by ring."""
+        vertices and vertex normals (r * :attr:`sides`, 3), ring by ring."""
         raise NotImplementedError
 
     def build(self) -> None:
         paths = self.document.paths
         self.ring_start = np.cumsum([0] + [p.n_rings for p in paths])
         """(n_segments + 1,) the first ring of each segment (and the number of rings)."""
-        n_ring_vertices = self.ring_start[-1] * SIDES
-        self._cap_start = n_ring_vertices + np.arange(len(paths)) * 2 * (SIDES + 1)
-        faces = [tube.tube_faces(p.n_rings, SIDES, self.ring_start[g] * SIDES) for g, p in enumerate(paths)]
-        caps = [tube.cap_faces(SIDES, start + end * (SIDES + 1)) for start in self._cap_start for end in (0, 1)]
-        n_vertices = n_ring_vertices + 2 * len(paths) * (SIDES + 1)
-        mesh = compact(pv.PolyData(np.zeros((n_vertices, 3)), faces=cells(faces + caps)))
-        mesh.point_data["Normals"] = np.zeros((n_vertices, 3))
+        sides = self.sides
+        n_ring_vertices = self.ring_start[-1] * sides
+        self._cap_start = n_ring_vertices + np.arange(len(paths)) * 2 * (sides + 1)
+        faces = [tube.tube_faces(p.n_rings, sides, self.ring_start[g] * sides) for g, p in enumerate(paths)]
+        caps = [tube.cap_faces(sides, start + end * (sides + 1)) for start in self._cap_start for end in (0, 1)]
+        n_vertices = n_ring_vertices + 2 * len(paths) * (sides + 1)
+        # single precision, as the renderer takes them: half the memory of a capsid's ribbons
+        mesh = compact(pv.PolyData(np.zeros((n_vertices, 3), np.float32), faces=cells(faces + caps)))
+        mesh.point_data["Normals"] = np.zeros((n_vertices, 3), np.float32)
         mesh.point_data.active_normals_name = "Normals"
         mesh.point_data["colours"] = np.zeros((n_vertices, 3), dtype=np.uint8)
         self.meshes[self.name] = mesh
@@ -103,11 +108,12 @@ class SweptLayer(SceneLayer):
         offset = self.scene.chains.offset
         ring_colours = np.concatenate([residue_colours[offset[g] + path.owner]
                                        for g, path in enumerate(self.document.paths)])
-        self.write(self.name, slice(0, len(ring_colours) * SIDES), np.repeat(ring_colours, SIDES, axis=0), "colours")
+        sides = self.sides
+        self.write(self.name, slice(0, len(ring_colours) * sides), np.repeat(ring_colours, sides, axis=0), "colours")
         for segment, path in enumerate(self.document.paths):
             first = self._cap_start[segment]
             ends = residue_colours[offset[segment] + path.owner[[0, -1]]]
-            self.write(self.name, slice(first, first + 2 * (SIDES + 1)), np.repeat(ends, SIDES + 1, axis=0),
+            self.write(self.name, slice(first, first + 2 * (sides + 1)), np.repeat(ends, sides + 1, axis=0),
                        "colours")
         if self._moving_rows:
             for name in self.moving_names:
@@ -119,8 +125,8 @@ class SweptLayer(SceneLayer):
         mesh = self.meshes[self.name]
         for segment in self.scene.chains.other_segments(chain):
             n_rings = self.document.paths[segment].n_rings
-            collapse(mesh, shift(slice(None), self.ring_start[segment], n_rings, SIDES))
-            collapse(mesh, slice(self._cap_start[segment], self._cap_start[segment] + 2 * (SIDES + 1)))
+            collapse(mesh, shift(slice(None), self.ring_start[segment], n_rings, self.sides))
+            collapse(mesh, slice(self._cap_start[segment], self._cap_start[segment] + 2 * (self.sides + 1)))
 
     def restore(self) -> None:
         if self.hidden():
@@ -154,18 +160,18 @@ class SweptLayer(SceneLayer):
         path = self.document.paths[segment]
         local = np.arange(path.n_rings)[rings]
         centres, tangents, points, normals = self.rings(segment, rings)
-        vertices = shift(rings, self.ring_start[segment], path.n_rings, SIDES)
+        vertices = shift(rings, self.ring_start[segment], path.n_rings, self.sides)
         self.write(self.name, vertices, points)
         self.write(self.name, vertices, normals, "Normals")
         for end, ring in ((0, 0), (1, path.n_rings - 1)):
             where = np.flatnonzero(local == ring)
             if len(where):
                 k = where[0]
-                rim = points[k * SIDES:(k + 1) * SIDES]
+                rim = points[k * self.sides:(k + 1) * self.sides]
                 cap, cap_normals = tube.cap_vertices(centres[k], rim, tangents[k] * (1 if end else -1))
-                first = self._cap_start[segment] + end * (SIDES + 1)
-                self.write(self.name, slice(first, first + SIDES + 1), cap)
-                self.write(self.name, slice(first, first + SIDES + 1), cap_normals, "Normals")
+                first = self._cap_start[segment] + end * (self.sides + 1)
+                self.write(self.name, slice(first, first + self.sides + 1), cap)
+                self.write(self.name, slice(first, first + self.sides + 1), cap_normals, "Normals")
         if self._moving_rows:
             self._copy_moving(self.moving_names[segment != self._moving_segment])
 
@@ -176,17 +182,17 @@ class SweptLayer(SceneLayer):
         segment = self.document.segment
         rows, faces = {}, {}
         edited, others_name = self.moving_names
-        first, last = self.ring_start[segment] * SIDES, self.ring_start[segment + 1] * SIDES
-        caps = np.arange(self._cap_start[segment], self._cap_start[segment] + 2 * (SIDES + 1))
+        first, last = self.ring_start[segment] * self.sides, self.ring_start[segment + 1] * self.sides
+        caps = np.arange(self._cap_start[segment], self._cap_start[segment] + 2 * (self.sides + 1))
         rows[edited] = np.r_[first:last, caps]
         n_rings = self.document.paths[segment].n_rings
-        faces[edited] = [tube.tube_faces(n_rings, SIDES)] + [
-            tube.cap_faces(SIDES, last - first + end * (SIDES + 1)) for end in (0, 1)]
+        faces[edited] = [tube.tube_faces(n_rings, self.sides)] + [
+            tube.cap_faces(self.sides, last - first + end * (self.sides + 1)) for end in (0, 1)]
         others, others_faces, start = [], [], 0
         for g, path in enumerate(self.document.paths):
             if g != segment:
-                kept, n_kept, sides = tube.coarse_rows(path.n_rings, SIDES, MOVING_RING_STEP, MOVING_SIDE_STEP)
-                others.append(kept + self.ring_start[g] * SIDES)
+                kept, n_kept, sides = tube.coarse_rows(path.n_rings, self.sides, MOVING_RING_STEP, MOVING_SIDE_STEP)
+                others.append(kept + self.ring_start[g] * self.sides)
                 others_faces.append(tube.tube_faces(n_kept, sides, start))
                 start += len(kept)
         rows[others_name], faces[others_name] = np.concatenate(others), others_faces

@@ -17,9 +17,8 @@ from app.editor.scene.curves import eased
 from app.editor.scene.layers.base import Layer
 from app.editor.scene.layers.chains import Others
 from app.editor.scene.layers.meshes import Rows, shift
-from app.editor.scene.layers.swept import SIDES, SweptLayer
+from app.editor.scene.layers.swept import SweptLayer
 
-TUBE_SIDES = SIDES
 TUBE_RADIUS = 0.55
 """Å, the tube of the full-resolution ribbon."""
 FAT_RADII = {"H": 1.5, "E": 1.8, "C": 0.45}
@@ -53,7 +52,7 @@ class TubeLayer(SweptLayer):
         centres, tangents = path.centres(self.document.model.ribbons[segment].points, rings)
         rows = shift(rings, self.ring_start[segment], path.n_rings)
         normals = tube.minimal_rotation(self._normals[rows], self._tangents[rows], tangents)
-        points, radial = tube.ring_vertices(centres, tangents, normals, self._radii[rows], SIDES)
+        points, radial = tube.ring_vertices(centres, tangents, normals, self._radii[rows], self.sides)
         return centres, tangents, points, radial
 
     def _ring_radii(self) -> np.ndarray:
