@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 from timing import best_ms
 
+from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
 from core.protein.secondary_structure import dssp
-from core.protein.structure import StructureError
 from core.protein.writing import write_structure
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"

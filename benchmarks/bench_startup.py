@@ -7,7 +7,9 @@ the structure read and drawn), until the first frame with the molecule in it is 
 time spent importing, until the window is painted on screen with its menus, docks and busy bar
 ("window"), loading the rest of the editor ("editor loads"), reading the structure and building its
 scene, and drawing that first frame, the total since the process started, and the processor time
-the process used: medians over the runs, after one untimed start that compiles the bytecode.
+the process used, and when the molecule was first sketched while the editor loads (since the
+process started: the 2D sketch of its trace, before the 3D view): medians over the runs, after one
+untimed start that compiles the bytecode.
 ``--against TREE`` (another checkout of ribbonwave, e.g. a ``git worktree add`` of an earlier
 commit) times that tree's editor too, its runs taking turns with this tree's (each tree
 first every other turn) so that both see the same load, and prints both columns and their
@@ -50,6 +52,20 @@ except ImportError:  # (a tree without a frame shown first: "window" is when its
 def shown():
     return [w for w in QApplication.topLevelWidgets() if w.isVisible() and hasattr(w, "menus")]
 
+try:
+    from app.editor import sketch
+except ImportError:  # (a tree without the molecule sketched while the editor loads)
+    sketch = None
+
+if sketch is not None:
+    paint = sketch.Sketch.paintEvent
+
+    def stamped_paint(self, event):
+        paint(self, event)
+        if self.trace is not None:
+            stamps.setdefault("sketched", time.time())
+    sketch.Sketch.paintEvent = stamped_paint
+
 if busy is not None:
     opening = busy.opening
 
@@ -84,7 +100,8 @@ window = min(stamps["window"], stamps["furnished"])
 print(json.dumps({"interpreter": t0 - started, "imports": t1 - t0, "window": window - t1,
                   "editor loads": stamps["furnished"] - window, "read and build": stamps["built"] - stamps["furnished"],
                   "first frame": stamps["drawn"] - stamps["built"],
-                  "total": stamps["drawn"] - started, "cpu": stamps["cpu"]}))
+                  "total": stamps["drawn"] - started, "cpu": stamps["cpu"],
+                  **({"molecule sketched": stamps["sketched"] - started} if "sketched" in stamps else {})}))
 """
 
 

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import gemmi
 
+from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
-from core.protein.structure import StructureError
 from core.protein.writing import write_structure
 
 SUFFIXES = (".pdb", ".ent", ".cif", ".mmcif")

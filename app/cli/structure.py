@@ -16,8 +16,9 @@ import numpy as np
 
 from app.arguments import bounded
 from app.errors import InputError
+from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
-from core.protein.structure import Structure, StructureError
+from core.protein.structure import Structure
 from core.protein.writing import output_format
 
 MAX_MODEL = 100_000

@@ -18,8 +18,9 @@ from app.arguments import bounded
 from app.cli.structure import model_argument
 from app.errors import InputError
 from app.polydata import scalar_style, to_polydata
+from core.protein.input_files import StructureError
 from core.protein.reading import read_atoms
-from core.protein.structure import AtomTable, StructureError
+from core.protein.structure import AtomTable
 from core.protein.writing import new_file_mode, staging_file
 from core.surfaces.dna import ideal_bdna
 from core.surfaces.levelled import KINDS, UNITS, LevelledSurface, build_surface

@@ -31,8 +31,9 @@ from app.editor.measurements import Measurements
 from app.editor.scene.curves import LevelCurve, SegmentPath, segment_paths
 from core.geometry.regularize import FLANK, regularize_region, regularized
 from core.protein.assembly import assembly_path, assembly_text
+from core.protein.input_files import read_bytes
 from core.protein.model import Edit, EditableModel
-from core.protein.reading import read_bytes, read_structure
+from core.protein.reading import read_structure
 from core.protein.ribbon import RibbonKind
 from core.protein.structure import Structure, ca_rows
 
@@ -195,7 +196,7 @@ class Document(QObject):
     def open(self, path: Path, kind: RibbonKind | str = RibbonKind.PEPTIDE, data: bytes | None = None,
              model: int = 1, assembly: int | None = None) -> None:
         """Read model ``model`` (1 .. n, in file order) of ``path`` (or of its content ``data``,
-        already read) and make it the document (raises :class:`core.protein.structure.StructureError`).
+        already read) and make it the document (raises :class:`core.protein.input_files.StructureError`).
         A structure without protein opens for viewing only (see :attr:`editable`). With
         ``assembly``, its biological assembly of that number (from 1), built from that model, is
         the document, as the mmCIF file :func:`~core.protein.assembly.assembly_path` names."""

@@ -13,8 +13,10 @@ import signal
 import sys
 import threading
 import traceback
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 from app import DEFAULT_STRUCTURE, PROG
 from app.arguments import IMAGE_SIDE, LEVEL, SUPERSAMPLING, bounded
@@ -22,6 +24,8 @@ from app.errors import InputError
 
 if TYPE_CHECKING:
     from app.editor.main_window import MainWindow
+
+T = TypeVar("T")
 
 MAX_SCRIPT_BYTES = 16 * 2**20
 MAX_MODEL = 100_000
@@ -152,6 +156,7 @@ def run_open(args: argparse.Namespace) -> int:
 
     from app.editor import busy
     from app.editor.main_window import MainWindow
+    from app.editor.sketch import read_trace
 
     if sys.platform.startswith("linux"):
         _check_display()
@@ -175,7 +180,11 @@ def run_open(args: argparse.Namespace) -> int:
         else:  # a person waits: the window at once, the editor as it loads, then the structure read and drawn
             window.show()
             with busy.opening(window, _opened_name(args)):
-                _import_meanwhile("app.editor.window_parts")
+                if not args.recover and args.assembly is None:  # (a session is no structure file: none drawn)
+                    trace = _meanwhile(partial(read_trace, args.file, args.model))
+                    if trace is not None:
+                        window.sketch(trace)
+                _meanwhile(partial(importlib.import_module, "app.editor.window_parts"))
                 if not window.isVisible():  # closed before anything was read
                     return 0
                 window.furnish()
@@ -221,9 +230,10 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
     """Open what the arguments name in ``window``: the most recent journal left by a crash,
     a session or a structure, then the level, hidden layers and compared structures."""
     from app.editor.persistence import journal, records
-    from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX, SessionError
+    from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
+    from app.editor.persistence.session import SessionError
     from app.editor.scene.scene import Layer
-    from core.protein.structure import StructureError
+    from core.protein.input_files import StructureError
 
     if args.recover:
         left, _ = journal.sweep(window.journal.folder)
@@ -271,27 +281,28 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
         window.comparison_panel.parentWidget().raise_()  # the dock listing them in front of its tab group
 
 
-def _import_meanwhile(module: str) -> None:
-    """Import ``module`` in a thread while the event loop runs here: the window shown meanwhile
-    is painted (its busy bar moves) and can be moved or closed."""
+def _meanwhile(work: Callable[[], T]) -> T:
+    """``work()`` done in a thread while the event loop runs here: the window shown meanwhile is
+    painted (its busy bar moves) and can be moved or closed."""
     from PySide6.QtCore import QEventLoop
     from PySide6.QtWidgets import QApplication
 
-    done, failed = threading.Event(), []
+    done, outcome, failed = threading.Event(), [], []
 
-    def load() -> None:
+    def run() -> None:
         try:
-            importlib.import_module(module)
+            outcome.append(work())
         except BaseException as error:  # noqa: BLE001 (raised again in the waiting thread)
             failed.append(error)
         finally:
             done.set()
 
-    threading.Thread(target=load, name=f"import {module}", daemon=True).start()
-    while not done.wait(0.02):  # (waiting releases the interpreter to the import)
+    threading.Thread(target=run, name="meanwhile", daemon=True).start()
+    while not done.wait(0.01):  # (waiting releases the interpreter to the work)
         QApplication.processEvents(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents)
     if failed:
         raise failed[0]
+    return outcome[0]
 
 
 def _opened_name(args: argparse.Namespace) -> Path:

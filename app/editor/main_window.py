@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QSettings, QSize, Qt, QTimer
 from PySide6.QtGui import QCloseEvent, QDragEnterEvent, QDropEvent, QKeySequence, QShowEvent
-from PySide6.QtWidgets import QDockWidget, QMainWindow, QSizePolicy, QUndoView, QWidget
+from PySide6.QtWidgets import QDockWidget, QMainWindow, QUndoView, QWidget
 
 from app import PROG
 from app.editor.composition import compose_once
@@ -39,10 +39,12 @@ from app.editor.docks.layout import (
     tidy_tab_bars,
 )
 from app.editor.features.menus import Menus
+from app.editor.sketch import Sketch
 from app.editor.source_reads import forget_sources_read_by_pyside
 
 if TYPE_CHECKING:
     from app.editor.document import Document
+    from app.editor.sketch import Trace
 
 forget_sources_read_by_pyside()  # before the window's parts are imported
 
@@ -76,10 +78,7 @@ class MainWindow(QMainWindow):
         self.setAcceptDrops(True)
         self.furnished = False
         self.menus = Menus(self)
-        blank = QWidget(autoFillBackground=True)  # where the 3D view will be, in its background colour
-        blank.setStyleSheet("background: white")
-        blank.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)  # (as the view's)
-        self.setCentralWidget(blank)
+        self.setCentralWidget(Sketch())  # where the 3D view will be, its background and the molecule sketched
         self.docks = self._make_docks()
         self.console_dock = self.docks[CONSOLE_DOCK]
         self._place_docks()
@@ -87,6 +86,11 @@ class MainWindow(QMainWindow):
         restore_layout(self, self.settings)
         if furnish:
             self.furnish(document)
+
+    def sketch(self, trace: Trace) -> None:
+        """Sketch ``trace`` where the 3D view will be, until the window is furnished."""
+        if not self.furnished:
+            self.centralWidget().draw(trace)
 
     def furnish(self, document: Document | None = None) -> None:
         """Build the 3D view, the features and the docks' panels on ``document`` (a new one when

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import gemmi
 
-from core.protein.reading import parse_model, read_bytes
-from core.protein.structure import StructureError
+from core.protein.input_files import StructureError, read_bytes
+from core.protein.reading import parse_model
 
 
 @dataclass(frozen=True)

@@ -46,10 +46,6 @@ SS_FROM_MMCIF = "mmCIF struct_conf/struct_sheet_range"
 SS_COMPUTED = "computed (DSSP, core.protein.secondary_structure)"
 
 
-class StructureError(ValueError):
-    """A file that cannot be used as a protein structure, or a bad argument to a writer."""
-
-
 @dataclass(frozen=True, eq=False)
 class BackboneSegment:
     """A continuous stretch of one protein chain (no Cα–Cα step above MAX_CA_STEP).

@@ -14,7 +14,8 @@ import gemmi
 import numpy as np
 from numpy.typing import NDArray
 
-from core.protein.structure import Structure, StructureError
+from core.protein.input_files import StructureError
+from core.protein.structure import Structure
 
 _PDB_SUFFIXES = (".pdb", ".ent")
 _MMCIF_SUFFIXES = (".cif", ".mmcif")

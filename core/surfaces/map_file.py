@@ -30,7 +30,7 @@ from typing import BinaryIO
 import gemmi
 import numpy as np
 
-from core.protein.reading import GUNZIP_CHUNK, input_limit, limit_text
+from core.protein.input_files import GUNZIP_CHUNK, input_limit, limit_text
 from core.surfaces.map_coefficients import is_mtz, read_mtz
 from core.surfaces.volume import DensityMap, MapError
 

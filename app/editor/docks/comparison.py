@@ -33,7 +33,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.editor.scene.overlay import CORE_CUTOFF, SAME_FOLD, Compared, Comparison, chains
-from core.protein.structure import StructureError
+from core.protein.input_files import StructureError
 
 STRUCTURE_FILTER = "Structures (*.pdb *.ent *.cif *.mmcif *.gz);;All files (*)"
 COLUMNS = ("Structure", "Chain", "TM-score", "Aligned", "rms (Å)", "")

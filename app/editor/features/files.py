@@ -26,7 +26,7 @@ from PySide6.QtWidgets import (
 from app import EXAMPLES_DIR, PROG
 from app.editor import busy
 from core.protein.assembly import assemblies, assembly_path
-from core.protein.structure import StructureError
+from core.protein.input_files import StructureError
 
 if TYPE_CHECKING:
     from PySide6.QtCore import QSettings

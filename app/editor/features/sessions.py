@@ -23,7 +23,7 @@ from app.editor.persistence import journal, records, session
 from app.editor.persistence.recording import recording, replay
 from app.editor.scene.molecule import Colouring
 from app.errors import printable
-from core.protein.structure import StructureError
+from core.protein.input_files import StructureError
 
 if TYPE_CHECKING:
     from app.editor.docks.panels import DisplayPanel

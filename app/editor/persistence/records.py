@@ -35,8 +35,8 @@ import numpy as np
 
 from app.editor.history import Base
 from app.editor.persistence import schema
+from core.protein.input_files import input_limit, limit_text
 from core.protein.model import Edit
-from core.protein.reading import input_limit, limit_text
 
 MAGIC = b"\x89RWAVE\r\n"
 """The first bytes of a journal or session file."""

@@ -11,9 +11,8 @@ from enum import StrEnum
 import numpy as np
 from scipy.spatial import cKDTree
 
+from app.editor.scene.looks import RGB, SS_COLOURS
 from core.protein.structure import Structure
-
-RGB = tuple[int, int, int]
 
 
 class Colouring(StrEnum):
@@ -24,7 +23,6 @@ class Colouring(StrEnum):
     CHAIN = "chain"
 
 
-SS_COLOURS: dict[str, RGB] = {"H": (222, 66, 91), "E": (246, 190, 0), "C": (176, 186, 198)}
 SS_NAMES = {"H": "helix", "E": "sheet", "C": "other"}
 
 RESIDUE_CLASSES: dict[str, tuple[RGB, tuple[str, ...]]] = {

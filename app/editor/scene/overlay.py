@@ -36,7 +36,8 @@ from app.editor.document import Document
 from app.editor.scene import tube
 from app.editor.scene.curves import LevelCurve, SegmentPath
 from core.analysis.superpose import MIN_PAIRS, Superposition, fit_closest
-from core.protein.reading import read_bytes, read_structure
+from core.protein.input_files import read_bytes
+from core.protein.reading import read_structure
 from core.protein.ribbon import Ribbon, segment_ribbon
 from core.protein.structure import BackboneSegment, Structure
 
@@ -210,7 +211,7 @@ class Comparison(QObject):
         """Read ``path`` (or its content ``data``), superpose ``chain`` (default: its longest) on the
         edited chain and show it.
 
-        Raises :class:`core.protein.structure.StructureError` (unreadable file) or ValueError (no such
+        Raises :class:`core.protein.input_files.StructureError` (unreadable file) or ValueError (no such
         chain, no protein, too few residue pairs, no structure open).
         """
         if not self.document.editable:

@@ -34,7 +34,9 @@ from app.editor.scene.layers.models import ModelsLayer
 from app.editor.scene.layers.nucleic import NucleicLayer
 from app.editor.scene.layers.selection import SelectionLayer
 from app.editor.scene.layers.tube import TubeLayer
+from app.editor.scene.looks import BACKGROUND, FIT_CLOSER, VIEW_ANGLE
 from app.editor.scene.molecule import Colouring
+from core.geometry.principal import principal_directions
 
 if TYPE_CHECKING:
     from app.editor.scene.view_base import View
@@ -58,13 +60,10 @@ DEFAULT_LAYERS = {Layer.CARTOON, Layer.CURVE, Layer.CONTROL_POINTS, Layer.NUCLEI
                   Layer.VALIDATION, Layer.MEASUREMENTS, Layer.MODELS}
 MIN_SLAB = 0.5
 """Å: the nearest a clipping plane comes to the centre of the view."""
-VIEW_ANGLE = 30.0
-"""Degrees: the camera's field of view (VTK's), never changed: zooming moves the camera."""
 STILL_AFTER_MS = 250
 """Full detail comes back once nothing has moved for this long."""
 CAPTION_COLOUR = "#2b2f36"
 CAPTION_PIXELS = 15
-BACKGROUND = ("#ffffff", "#dfe5ec")
 
 L = TypeVar("L", bound=SceneLayer)
 
@@ -191,12 +190,12 @@ class Scene(QObject):
         coords = self.document.model.coords
         ca = coords[self.document.ca_rows] if len(self.document.ca_rows) else coords
         centre = ca.mean(axis=0)
-        _, axes = np.linalg.eigh((ca - centre).T @ (ca - centre))  # by increasing extent; any number of atoms
+        least, middle, _ = principal_directions(((ca - centre).T @ (ca - centre)).tolist())  # as the sketch
         renderer = self.plotter.renderer
-        renderer.camera_position = [tuple(centre + axes[:, 0] * 100.0), tuple(centre), tuple(axes[:, 1])]
+        renderer.camera_position = [tuple(centre + np.array(least) * 100.0), tuple(centre), middle]
         renderer.camera.SetViewAngle(VIEW_ANGLE)  # (a zoom that narrowed it compounded with every reset)
         renderer.reset_camera(render=False)
-        renderer.camera.Dolly(1.15)  # a little closer than the fit: where the camera is says it all (sessions)
+        renderer.camera.Dolly(FIT_CLOSER)  # (where the camera is says it all: sessions keep it)
         renderer.ResetCameraClippingRange()
 
     def frame_segment(self) -> None:

@@ -16,8 +16,8 @@ from app.editor.persistence import records, session
 from app.editor.persistence.recording import recording as recorded
 from app.editor.persistence.recording import replay
 from app.main import main
+from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
-from core.protein.structure import StructureError
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 NMR = DATA / "1L2Y.pdb.gz"

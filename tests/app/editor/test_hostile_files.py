@@ -20,8 +20,8 @@ from test_window import _window
 
 from app.editor.main_window import MainWindow
 from app.editor.persistence import journal, records
+from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
-from core.protein.structure import StructureError
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 FUZZ = settings(max_examples=300, deadline=None, derandomize=True, database=None,

@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[3]
 FIRST_PAINT = """
 import contextlib, json, sys
 from PySide6.QtWidgets import QApplication, QDockWidget
-from app.editor import busy
+from app.editor import busy, sketch
 from app.main import main
 
 opening, seen = busy.opening, {}
@@ -48,7 +48,15 @@ def run(app):
     window.quit_unattended(discard=True)
     return 0
 
-busy.opening, QApplication.exec = watched, run
+def sketched(self, event):
+    paint(self, event)
+    if self.trace is not None:
+        seen.setdefault("sketch", {"residues": sum(len(run.positions) for run in self.trace.runs),
+                                   "furnished": self.window().furnished,
+                                   "loaded": sorted(name for name in sys.argv[2:] if name in sys.modules)})
+
+paint = sketch.Sketch.paintEvent
+sketch.Sketch.paintEvent, busy.opening, QApplication.exec = sketched, watched, run
 seen["status"] = main([sys.argv[1]])
 print(json.dumps(seen))
 """
@@ -106,7 +114,8 @@ def test_a_bad_file_closes_the_staged_window_and_says_why(qtbot: QtBot, tmp_path
 def test_the_window_is_painted_before_the_editor_loads(tmp_path: Path) -> None:
     """In a fresh process the window is on screen, painted with its menus, its docks and the file's
     name, before numpy, scipy, gemmi, VTK, PyVista or the editor's own parts are imported: it
-    needs Qt alone. They load while it shows, and the structure follows. The docks keep their
+    needs Qt alone. Then the molecule is sketched, with gemmi alone more. The rest loads while it
+    shows, and the structure follows in 3D. The docks keep their
     places as their panels come (the view, not the docks, takes the room), this run and the next,
     which starts from the layout this one kept."""
     env = {**os.environ, "XDG_STATE_HOME": str(tmp_path), "XDG_CONFIG_HOME": str(tmp_path)}
@@ -120,6 +129,7 @@ def test_the_window_is_painted_before_the_editor_loads(tmp_path: Path) -> None:
         assert window["visible"] and window["title"] == "1UBQ.pdb.gz — ribbonwave" and window["loaded"] == []
         assert window["menus"] == ["&File", "&Edit", "&View", "&Help"]
         assert {"Ribbon dimension", "Display", "Sequence"} <= set(window["docks"])
+        assert seen["sketch"] == {"residues": 76, "furnished": False, "loaded": ["gemmi"]}  # before numpy, VTK, ...
         assert seen["status"] == 0 and seen["then"]["loaded"] == sorted(HEAVY) and seen["then"]["residues"] > 70
         (column, sequence, _, _), (then_column, then_sequence, view_width, view_height) = (
             window["layout"], seen["then"]["layout"])
@@ -132,15 +142,16 @@ def test_the_window_is_painted_before_the_editor_loads(tmp_path: Path) -> None:
 def test_closing_the_window_while_the_editor_loads_ends_quietly(qtbot: QtBot, monkeypatch: pytest.MonkeyPatch) -> None:
     """Closed before the structure is read (the person changed their mind): exit status 0, the
     file never read, no dialog, nothing left open."""
-    wait, read = launch._import_meanwhile, []
+    wait, read = launch._meanwhile, []
 
-    def closed_meanwhile(module: str) -> None:
-        window = next(w for w in QApplication.topLevelWidgets() if w.isVisible() and hasattr(w, "menus"))
-        assert not window.furnished
-        window.close()  # as the window's close button does while the editor loads
-        wait(module)
+    def closed_meanwhile(work: object) -> object:
+        for window in QApplication.topLevelWidgets():
+            if hasattr(window, "menus") and window.isVisible():
+                assert not window.furnished
+                window.close()  # as the window's close button does while the editor loads
+        return wait(work)
 
-    monkeypatch.setattr(launch, "_import_meanwhile", closed_meanwhile)
+    monkeypatch.setattr(launch, "_meanwhile", closed_meanwhile)
     monkeypatch.setattr(Document, "open", lambda *args, **kwargs: read.append(args))
     assert main([str(DATA / "1UBQ.pdb.gz")]) == 0
     assert read == [] and not any(window.isVisible() for window in QApplication.topLevelWidgets())

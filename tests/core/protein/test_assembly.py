@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from core.protein.assembly import assemblies, assembly_path, assembly_text
+from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
-from core.protein.structure import StructureError
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 

@@ -9,8 +9,9 @@ import gemmi
 import numpy as np
 import pytest
 
+from core.protein.input_files import StructureError
 from core.protein.reading import read_atoms, read_structure
-from core.protein.structure import Structure, StructureError
+from core.protein.structure import Structure
 from core.protein.writing import write_structure
 
 DATA = Path(__file__).resolve().parents[2] / "data"

@@ -12,16 +12,9 @@ import gemmi
 import numpy as np
 import pytest
 
+from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
-from core.protein.structure import (
-    MAX_CA_STEP,
-    SS_COMPUTED,
-    SS_FROM_MMCIF,
-    SS_FROM_PDB_RECORDS,
-    Structure,
-    StructureError,
-    ca_rows,
-)
+from core.protein.structure import MAX_CA_STEP, SS_COMPUTED, SS_FROM_MMCIF, SS_FROM_PDB_RECORDS, Structure, ca_rows
 from core.protein.writing import write_structure
 
 DATA = Path(__file__).resolve().parents[2] / "data"

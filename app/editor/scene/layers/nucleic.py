@@ -11,8 +11,8 @@ import pyvista as pv
 from app.editor.scene import nucleic
 from app.editor.scene.layers.base import Layer, SceneLayer
 from app.editor.scene.layers.meshes import cells, collapse
+from app.editor.scene.looks import NUCLEIC_BACKBONE
 
-BACKBONE = 120
 """The grey of the backbone tube."""
 _STYLE = {"scalars": "colours", "rgb": True, "interpolation": "phong", "specular": 0.3, "specular_power": 20.0,
           "diffuse": 0.8, "ambient": 0.2}
@@ -31,7 +31,7 @@ class NucleicLayer(SceneLayer):
         """The nucleotides drawn."""
         coords = self.document.model.coords
         points, normals, quads, self._tube_owner = nucleic.backbone_tube(coords, self.found)
-        self.meshes["nucleic_tube"] = _mesh(points, quads, np.full((len(points), 3), BACKBONE), normals)
+        self.meshes["nucleic_tube"] = _mesh(points, quads, np.full((len(points), 3), NUCLEIC_BACKBONE), normals)
         self.add("nucleic_tube", **_STYLE)
         points, triangles, self._base_owner = nucleic.base_slabs(coords, self.found)
         self.meshes["nucleic_bases"] = _mesh(points, triangles, self.found.colours[self._base_owner])
