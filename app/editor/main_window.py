@@ -9,10 +9,11 @@ image export, help) builds its own actions and slots and puts them in the menus
 (:class:`~app.editor.features.menus.Menus`); the window only lays out the docks, keeps its
 layout between runs and closes in order.
 
-The window is built in two steps. Its frame (menus, tool bar, the docks in their places, a
-blank view) needs Qt alone and shows at once; :meth:`MainWindow.furnish` then builds the
-rest from :mod:`app.editor.window_parts`, which loads numpy, scipy, VTK and PyVista. A window
-made with ``MainWindow()`` is furnished at once; ``ribbonwave FILE`` shows the frame first
+The window is built in two steps. Its frame (menus, tool bar, the docks in their places, where
+the view will be its background, and the molecule once :meth:`MainWindow.sketch` is given its
+trace) needs Qt alone and shows at once; :meth:`MainWindow.furnish` then builds the rest from
+:mod:`app.editor.window_parts`, which loads numpy, scipy, VTK and PyVista. A window made with
+``MainWindow()`` is furnished at once; ``ribbonwave FILE`` shows the frame first
 (:func:`app.editor.launch.run_open`).
 """
 
