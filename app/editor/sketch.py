@@ -5,6 +5,7 @@ tens of milliseconds after its window, and the 3D view takes its place once load
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,6 +29,9 @@ RIBBON_REACH = 1.4
 """Å: how far the ribbon reaches beyond the trace (the view's fit takes in the ribbon)."""
 FOG = 0.45
 """How much of the background the farthest part of the trace takes on (depth cueing)."""
+DEPTH_BANDS = 64
+"""The trace's steps are drawn in this many bands of depth, each band's of one kind at once with
+one pen (a capsid's hundred thousand steps in a fraction of a second)."""
 LARGEST_SKETCHED = 4 * 2**20
 """Bytes, as stored: a larger file is not sketched (read twice, its 3D view would come seconds later)."""
 
@@ -55,9 +59,28 @@ class Trace:
     runs: tuple[Run, ...]
     looked_at: tuple[Vector, ...]
 
+    @functools.cached_property
+    def directions(self) -> tuple[Vector, Vector]:
+        """The view's first direction (from the structure towards the camera) and up: the
+        directions of least and middle extent of :attr:`looked_at`."""
+        n = len(self.looked_at)
+        centre = [sum(p[k] for p in self.looked_at) / n for k in range(3)]
+        scatter = [[sum((p[i] - centre[i]) * (p[j] - centre[j]) for p in self.looked_at) for j in range(3)]
+                   for i in range(3)]
+        towards, up, _ = principal_directions(scatter)
+        return towards, up
+
+    @functools.cached_property
+    def bounds(self) -> tuple[Vector, Vector]:
+        """The lowest and highest coordinates of the runs, widened by the ribbon's reach."""
+        points = [p for run in self.runs for p in run.positions]
+        low = tuple(min(p[k] for p in points) - RIBBON_REACH for k in range(3))
+        high = tuple(max(p[k] for p in points) + RIBBON_REACH for k in range(3))
+        return low, high  # type: ignore[return-value]
+
     def camera(self, aspect: float) -> Camera:
         """The 3D view's first camera on the structure in a view ``aspect`` (width / height) wide."""
-        return Camera.fitting(self.looked_at, [p for run in self.runs for p in run.positions], aspect)
+        return Camera.fitting(*self.directions, *self.bounds, aspect)
 
 
 def read_trace(path: Path, model: int = 1) -> Trace | None:
@@ -139,16 +162,9 @@ class Camera:
     distance: float
 
     @classmethod
-    def fitting(cls, looked_at: list[Vector], everything: list[Vector], aspect: float) -> Camera:
-        """Looking along the direction of least extent of ``looked_at``, fitting ``everything`` in a
-        view ``aspect`` (width / height) wide."""
-        n = len(looked_at)
-        centre = [sum(p[k] for p in looked_at) / n for k in range(3)]
-        scatter = [[sum((p[i] - centre[i]) * (p[j] - centre[j]) for p in looked_at) for j in range(3)]
-                   for i in range(3)]
-        towards, up, _ = principal_directions(scatter)
-        low = [min(p[k] for p in everything) - RIBBON_REACH for k in range(3)]
-        high = [max(p[k] for p in everything) + RIBBON_REACH for k in range(3)]
+    def fitting(cls, towards: Vector, up: Vector, low: Vector, high: Vector, aspect: float) -> Camera:
+        """Looking along ``-towards`` with ``up`` up, fitting the box from ``low`` to ``high`` in
+        a view ``aspect`` (width / height) wide, as VTK fits a scene, then a little closer."""
         angle = math.radians(VIEW_ANGLE)
         if aspect < 1.0:  # (VTK's fit: a vertical view angle narrows with a tall view)
             angle = 2.0 * math.atan(math.tan(angle / 2.0) * aspect)
@@ -192,7 +208,8 @@ class Sketch(QWidget):
 
     @staticmethod
     def _draw_trace(painter: QPainter, trace: Trace, width: int, height: int) -> None:
-        """The trace's steps from the farthest to the nearest, as wide as the ribbon, fading with depth."""
+        """The trace's steps from the farthest band of depth to the nearest, as wide as the ribbon,
+        fading with depth."""
         painter.setRenderHint(QPainter.RenderHint.Antialiasing)
         camera = trace.camera(width / max(height, 1))
         focal = height / 2.0 / math.tan(math.radians(VIEW_ANGLE) / 2.0)
@@ -205,13 +222,19 @@ class Sketch(QWidget):
                 steps.append(((z0 + z1) / 2.0, QLineF(x0, y0, x1, y1), kind))
         steps.sort(key=lambda step: -step[0])  # the farthest first: the nearer cover them
         near, far = steps[-1][0], steps[0][0]
+        depth_of_band = (far - near) / DEPTH_BANDS
+        bands: dict[tuple[int, str], list[QLineF]] = {}  # (band, kind): its steps, from the farthest band
+        for depth, line, kind in steps:
+            band = min(int((far - depth) / max(depth_of_band, 1e-9)), DEPTH_BANDS - 1)
+            bands.setdefault((band, kind), []).append(line)
         pen = QPen(Qt.PenStyle.SolidLine)
         pen.setCapStyle(Qt.PenCapStyle.RoundCap)
-        for depth, line, kind in steps:
+        for (band, kind), lines in bands.items():
+            depth = far - (band + 0.5) * depth_of_band
             pen.setColor(_mixed(COLOURS[kind], QColor(BACKGROUND[0]), FOG * (depth - near) / max(far - near, 1e-6)))
             pen.setWidthF(2.0 * HALF_WIDTHS[kind] * focal / max(depth, 1e-6))
             painter.setPen(pen)
-            painter.drawLine(line)
+            painter.drawLines(lines)
 
 
 def _mixed(colour: RGB, background: QColor, share: float) -> QColor:
