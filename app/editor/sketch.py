@@ -34,12 +34,11 @@ DEPTH_BANDS = 64
 one pen (a capsid's hundred thousand steps in a fraction of a second)."""
 LARGEST_SKETCHED = 4 * 2**20
 """Bytes, as stored: a larger file is not sketched (read twice, its 3D view would come seconds later)."""
-
-
 LONGEST_STEP = {"protein": 4.2, "nucleic": 9.0}
 """Å: the longest step between the Cα (as the structure's segments: ``MAX_CA_STEP``) or the P
 (as the nucleic acids' tube: ``GAP``) of consecutive residues drawn; a longer one is a gap."""
 COLOURS = {**SS_COLOURS, "N": NUCLEIC_BACKBONE}
+"""The colour of each kind of step, as the 3D view's."""
 
 
 @dataclass(frozen=True)
@@ -97,12 +96,14 @@ def read_trace(path: Path, model: int = 1) -> Trace | None:
             st = gemmi.make_structure_from_block(gemmi.cif.read_string(text)[0])
         else:
             st = gemmi.read_pdb_string(text)
+        if not 1 <= model <= len(st):
+            return None
         st.setup_entities()
-        runs = _runs(st[model - 1], _secondary_structure(st, st[model - 1]))
+        chosen = st[model - 1]
+        runs = _runs(chosen, _secondary_structure(st, chosen))
         looked_at = [p for run in runs if run.kinds[0] != "N" for p in run.positions]
         if runs and not looked_at:
-            looked_at = [(atom.pos.x, atom.pos.y, atom.pos.z) for chain in st[model - 1] for residue in chain
-                         for atom in residue]
+            looked_at = [(atom.pos.x, atom.pos.y, atom.pos.z) for chain in chosen for residue in chain for atom in residue]
     except Exception:  # noqa: BLE001 (anything the full read reports, with its reason)
         return None
     return Trace(runs, tuple(looked_at)) if runs else None

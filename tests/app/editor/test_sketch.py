@@ -36,6 +36,12 @@ def test_the_trace_runs_as_the_structure_segments_in_their_secondary_structure(n
         np.testing.assert_allclose(np.array(run.positions), segment.ca, atol=1e-3)
 
 
+def test_the_model_asked_for_is_traced() -> None:
+    trace, structure = read_trace(DATA / "1L2Y.pdb.gz", model=7), read_structure(DATA / "1L2Y.pdb.gz", model=7)
+    np.testing.assert_allclose(np.array(trace.runs[0].positions), structure.segments[0].ca, atol=1e-3)
+    assert not np.allclose(np.array(read_trace(DATA / "1L2Y.pdb.gz").runs[0].positions), structure.segments[0].ca)
+
+
 def test_nucleic_acids_are_traced_through_their_phosphates() -> None:
     """As the view's tube: through each nucleotide's P (C4' where it has none), strands apart."""
     trace = read_trace(DATA / "1BNA.pdb.gz")  # a B-DNA dodecamer: two strands, the first of each without P
@@ -57,6 +63,7 @@ def test_what_cannot_be_read_is_not_sketched(tmp_path: Path, monkeypatch: pytest
     for path in (garbage, empty, water, big, tmp_path, tmp_path / "missing.pdb"):
         assert read_trace(path) is None, path
     assert read_trace(DATA / "1UBQ.pdb.gz") is not None
+    assert read_trace(DATA / "1UBQ.pdb.gz", model=2) is None and read_trace(DATA / "1UBQ.pdb.gz", model=0) is None
     monkeypatch.setattr(sketch, "LARGEST_SKETCHED", (DATA / "1UBQ.pdb.gz").stat().st_size - 1)
     assert read_trace(DATA / "1UBQ.pdb.gz") is None
 
