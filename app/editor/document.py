@@ -401,8 +401,7 @@ class Document(QObject):
         self.ca_rows = ca_rows(model.structure)
         longest = int(np.argmax([len(s) for s in model.structure.segments])) if model.ribbons else 0
         self.segment = segment if keep_view and segment < len(model.ribbons) else longest
-        default = float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
-        self.level = min(level, self.max_level) if keep_view else default
+        self.level = min(level, self.max_level) if keep_view else float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
         self.pick = None
         self.selection = np.empty(0, dtype=np.int64)
         self._preview = None

@@ -180,7 +180,8 @@ def run_open(args: argparse.Namespace) -> int:
         else:  # a person waits: the window at once, the editor as it loads, then the structure read and drawn
             window.show()
             with busy.opening(window, _opened_name(args)):
-                if not args.recover and args.assembly is None:  # (a session is no structure file: none drawn)
+                # the file as stored is sketched, not restored edits or an assembly (nor a session: no atoms)
+                if not args.recover and args.assembly is None:
                     trace = _meanwhile(partial(read_trace, args.file, args.model))
                     if trace is not None:
                         window.sketch(trace)

@@ -173,13 +173,18 @@ class Camera:
         distance = 0.5 * math.dist(low, high) / math.sin(angle / 2.0) / FIT_CLOSER
         return cls(focal, _cross(up, towards), up, towards, distance)
 
-    def project(self, point: Vector, width: int, height: int) -> tuple[float, float, float]:
-        """Pixel column and row of ``point`` in a view ``width`` × ``height``, and its distance
-        from the camera along the view."""
+    def project(self, point: Vector, width: int, height: int, focal: float) -> tuple[float, float, float]:
+        """Pixel column and row of ``point`` in a view ``width`` × ``height`` whose focal length is
+        ``focal`` pixels (:func:`focal_length`), and its distance from the camera along the view."""
         d = [point[k] - self.focal[k] for k in range(3)]
         depth = self.distance - _dot(d, self.towards)
-        scale = height / 2.0 / math.tan(math.radians(VIEW_ANGLE) / 2.0) / max(depth, 1e-6)
+        scale = focal / max(depth, 1e-6)
         return width / 2.0 + scale * _dot(d, self.right), height / 2.0 - scale * _dot(d, self.up), depth
+
+
+def focal_length(height: int) -> float:
+    """Pixels: the focal length of a view ``height`` pixels tall (VTK's vertical view angle)."""
+    return height / 2.0 / math.tan(math.radians(VIEW_ANGLE) / 2.0)
 
 
 class Sketch(QWidget):
@@ -213,10 +218,10 @@ class Sketch(QWidget):
         fading with depth."""
         painter.setRenderHint(QPainter.RenderHint.Antialiasing)
         camera = trace.camera(width / max(height, 1))
-        focal = height / 2.0 / math.tan(math.radians(VIEW_ANGLE) / 2.0)
+        focal = focal_length(height)
         steps = []
         for run in trace.runs:
-            projected = [camera.project(p, width, height) for p in run.positions]
+            projected = [camera.project(p, width, height, focal) for p in run.positions]
             for k in range(len(projected) - 1):
                 (x0, y0, z0), (x1, y1, z1) = projected[k], projected[k + 1]
                 kind = run.kinds[k] if run.kinds[k] == run.kinds[k + 1] else "C"
