@@ -14,6 +14,7 @@ import json
 import os
 import sys
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -95,6 +96,9 @@ def search_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_search(args: argparse.Namespace) -> int:
     path, chain = _query(args.query)
+    if zipfile.is_zipfile(path):  # (an index is a zip archive; no structure file is)
+        raise InputError(f"{path}: a fold index, not a structure: give the query's structure first, then the index "
+                         "(ribbonwave search QUERY DB)")
     structure = load(path)
     chain = chain or _longest_chain(structure)
     segments = [s for s in structure.segments if s.chain == chain]

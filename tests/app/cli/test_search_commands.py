@@ -124,6 +124,13 @@ def test_a_peptide_is_refused_as_a_query(index_file, tmp_path, capsys):
     assert status == 0 and "chain A (20 residues)" in out
 
 
+def test_the_index_given_first_is_named_as_such(index_file, capsys):
+    """The usual slip, ``search DB QUERY``, says which argument goes where."""
+    status, _, err = run(capsys, "search", index_file, DATA / "1UBQ.pdb.gz")
+    assert status == 1 and "a fold index, not a structure: give the query's structure first" in err
+    assert "Traceback" not in err
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
