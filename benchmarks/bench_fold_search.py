@@ -28,7 +28,10 @@ averaged over the queries. One line per method, with the CPU seconds per query:
 (the shared set's 255 entries), and ``search`` measured again. A decoy counts as a domain of
 another fold unless exhaustive TM-align finds it of the query's fold (TM-score by the query
 0.5 or more: a sialidase among the decoys is a true match of a sialidase domain); such decoys
-are set aside, and counted.
+are set aside, and counted. It prints the TM-scores (TM-align's, by the query) of the decoys
+that were a query's first false positive, and of the true positives ranked behind them. With
+``--tm-align N``, exhaustive TM-align ranks the padded index as well, its decoys judged by its
+own TM-scores, and the search's padded line is repeated for those N queries.
 
 ``--pdb-scale N``: the cost at the size of the PDB. An index of ``N`` chains (800,000: the
 PDB's protein chains) is written to ``DIR``: the chains of the structures in ``--base``
@@ -91,34 +94,49 @@ def chain(index: FoldIndex, row: int) -> tuple[np.ndarray, str]:
     return ca, codes.tobytes().decode("ascii")
 
 
-_RANK: Callable[[int], np.ndarray] | None = None
-"""The ranking :func:`measure`'s worker processes run (inherited by fork: closures do not pickle)."""
+_TASK: Callable[[int], object] | None = None
+"""What :func:`run_queries`' worker processes run (inherited by fork: closures do not pickle)."""
 
 
-def _timed(row: int) -> tuple[np.ndarray, float]:
-    start = time.process_time()
-    ranked = _RANK(row)
-    return ranked, time.process_time() - start
+def _task(row: int) -> object:
+    return _TASK(row)
 
 
-def measure(name: str, rank: Callable[[int], np.ndarray], queries: list[int], labels: dict[str, np.ndarray],
-            jobs: int = 1) -> None:
-    """Print one line of the table: the mean sensitivity of ``rank``'s rankings of ``queries``
-    and its CPU per query (each query timed in the process that ranks it, ``jobs`` at once)."""
-    global _RANK
-    _RANK = rank
+def run_queries(task: Callable[[int], object], queries: list[int], jobs: int = 1) -> list:
+    """``task(row)`` for each query, ``jobs`` at once in worker processes."""
+    global _TASK
+    _TASK = task
     if jobs > 1:
         with ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork")) as pool:
-            results = list(pool.map(_timed, queries))
-    else:
-        results = [_timed(row) for row in queries]
-    cpu = [seconds for _, seconds in results]
+            return list(pool.map(_task, queries))
+    return [task(row) for row in queries]
+
+
+def report(name: str, rankings: list[np.ndarray], cpu: list[float], queries: list[int],
+           labels: dict[str, np.ndarray]) -> None:
+    """Print one line of the table: the mean sensitivity of the ``rankings`` of ``queries`` and
+    the mean CPU seconds per query."""
     scores = [sensitivity(ranked, *(labels[level] for level in LEVELS), row)
-              for (ranked, _), row in zip(results, queries, strict=True)]
+              for ranked, row in zip(rankings, queries, strict=True)]
     found = np.array([score for score in scores if score is not None])
     print(f"{name:<52}{len(found):>8}" + "".join(f"{value:>{width}.3f}" for value, width in
                                                   zip(found.mean(axis=0), (8, 10, 7), strict=True))
           + f"{np.mean(cpu):>13.3f}", flush=True)
+
+
+def measure(name: str, rank: Callable[[int], np.ndarray], queries: list[int], labels: dict[str, np.ndarray],
+            jobs: int = 1) -> tuple[list[np.ndarray], list[float]]:
+    """Print one line of the table for ``rank``'s rankings of ``queries``, each timed in the
+    process that ranks it (``jobs`` at once); return the rankings and their CPU seconds."""
+    def timed(row: int) -> tuple[np.ndarray, float]:
+        start = time.process_time()
+        ranked = rank(row)
+        return ranked, time.process_time() - start
+
+    results = run_queries(timed, queries, jobs)
+    rankings, cpu = [ranked for ranked, _ in results], [seconds for _, seconds in results]
+    report(name, rankings, cpu, queries, labels)
+    return rankings, cpu
 
 
 def screen_kept(index: FoldIndex, queries: list[int], labels: dict[str, np.ndarray]) -> None:
@@ -174,34 +192,84 @@ def scop_sensitivity(folder: Path, tm_align_queries: int, decoys: Path | None, o
     measure("curve descriptors alone", lambda row: np.argsort(
         descriptor_distances(index.descriptors, index.descriptors[row]), kind="stable"), queries, labels)
     screen_kept(index, queries, labels)
-    if tm_align_queries:
-        asked = queries[:tm_align_queries]
-        measure(f"search on the first {len(asked)} queries", searched, asked, labels)
-        measure("exhaustive TM-align (tmtools, by the query)", lambda row: np.argsort(-np.array(
-            [tmtools.tm_align(chains[row][0], other, chains[row][1], codes).tm_norm_chain1
-             for other, codes in chains]), kind="stable"), asked, labels, jobs)
     if decoys is not None:
         padding, _ = build_index(structure_paths([decoys]))
         padded = merge([index, padding])
         other = {level: np.concatenate([labels[level], [f"decoy {k}" for k in range(len(padding))]])
                  for level in LEVELS}
-        set_aside = []
+    else:
+        padding, padded = None, index
+
+    def judged(row: int, k: int) -> float:
+        """TM-align's TM-score of chain ``k`` of the padded index by query ``row``."""
+        ca, codes = chain(padded, k)
+        return tmtools.tm_align(chains[row][0], ca, chains[row][1], codes).tm_norm_chain1
+
+    asked = queries[:tm_align_queries]
+    if tm_align_queries:
+        measure(f"search on the first {len(asked)} queries", searched, asked, labels)
+
+        def tm_aligned(row: int) -> tuple[np.ndarray, float, float]:
+            """TM-align's TM-score by the query of every chain of the padded index; the CPU
+            seconds for the labelled domains, and for all."""
+            start = time.process_time()
+            scores = [judged(row, k) for k in range(every)]
+            labelled = time.process_time()
+            scores += [judged(row, k) for k in range(every, len(padded))]
+            return np.array(scores), labelled - start, time.process_time() - start
+
+        aligned = run_queries(tm_aligned, asked, jobs)
+        report("exhaustive TM-align (tmtools, by the query)",
+               [np.argsort(-scores[:every], kind="stable") for scores, _, _ in aligned],
+               [cpu for _, cpu, _ in aligned], asked, labels)
+        if padding is not None:  # its decoys judged by its own TM-scores, as the search's are below
+            kept = [ranked[(ranked < every) | (scores[ranked] < SAME_FOLD)] for scores, ranked in
+                    ((scores, np.argsort(-scores, kind="stable")) for scores, _, _ in aligned)]
+            report(f"exhaustive TM-align, padded with {len(padding)} decoys", kept,
+                   [cpu for _, _, cpu in aligned], asked, other)
+    if padding is not None:
+        set_aside: list[int] = []
+        outranking: list[tuple[float, list[float]]] = []
 
         def unrelated(row: int) -> np.ndarray:
             """The padded ranking less the decoys ranked before the query's last true positive
-            that exhaustive TM-align finds of the query's fold (TM-score by the query 0.5 or more)."""
+            that exhaustive TM-align finds of the query's fold (TM-score by the query 0.5 or more);
+            when the first false positive left is a decoy, its TM-score and its victims' are kept."""
             ranked = searched(row, padded)
             same_fold = np.flatnonzero(other["fold"][ranked] == labels["fold"][row])
             last = same_fold[-1] if len(same_fold) else 0
-            kept = [k for position, k in enumerate(ranked.tolist()) if k < every or position > last
-                    or tmtools.tm_align(chains[row][0], padded.chain(k)[0], chains[row][1],
-                                        padded.chain(k)[1].tobytes().decode("ascii")).tm_norm_chain1 < SAME_FOLD]
+            kept, first = [], None
+            for position, k in enumerate(ranked.tolist()):
+                if k >= every and position <= last:
+                    score = judged(row, k)
+                    if score >= SAME_FOLD:
+                        continue
+                    first = (score, position) if first is None else first
+                elif first is None and k < every and labels["fold"][k] != labels["fold"][row]:
+                    first = (np.nan, position)
+                kept.append(k)
+            victims = [] if first is None or np.isnan(first[0]) else [
+                k for k in ranked[first[1]:last + 1].tolist() if k < every and k != row
+                and labels["fold"][k] == labels["fold"][row]]
+            if victims:
+                outranking.append((first[0], [judged(row, k) for k in victims]))
             set_aside.append(len(ranked) - len(kept))
             return np.array(kept)
 
-        measure(f"search, index padded with {len(padding)} decoy chains", unrelated, queries, other)
+        rankings, cpu = measure(f"search, index padded with {len(padding)} decoy chains", unrelated, queries, other)
+        if tm_align_queries:
+            report(f"  the same on the first {len(asked)} queries", rankings[:len(asked)], cpu[:len(asked)], asked,
+                   other)
         print(f"  decoys of the query's fold by TM-align (TM-score >= {SAME_FOLD}), set aside: {sum(set_aside)} "
               f"({np.mean(set_aside):.1f} a query; the CPU above includes these TM-align runs)")
+        if outranking:
+            decoy_scores = np.array([score for score, _ in outranking])
+            victim_scores = np.array([score for _, scores in outranking for score in scores])
+            print(f"  a decoy was the first false positive, ahead of {len(victim_scores)} true positives, "
+                  f"in {len(outranking)} queries; TM-align by the query, median (range): those decoys "
+                  f"{np.median(decoy_scores):.2f} ({decoy_scores.min():.2f}-{decoy_scores.max():.2f}), "
+                  f"the true positives behind them {np.median(victim_scores):.2f} "
+                  f"({victim_scores.min():.2f}-{victim_scores.max():.2f})")
 
 
 def pdb_scale(chains: int, base: Path, scratch: Path, keep: bool = False) -> None:

@@ -150,7 +150,7 @@ def main() -> None:
     print(f"  {'':<15}" + "".join(f" {name:>8}" for name in names) + (f" {'ratio':>6}" if len(names) == 2 else "")
           + (f"    against: {trees[1]}" if args.against is not None else ""))
     for key, values in rows.items():
-        ratio = f" {values[0] / values[1]:6.2f}" if len(values) == 2 and values[1] else ""
+        ratio = f" {values[0] / values[1]:6.2f}" if len(values) == 2 and values[1] and np.isfinite(values).all() else ""
         print(f"  {key:<15}" + "".join(f" {'—':>8}" if np.isnan(value) else f" {value:8.2f}" for value in values)
               + ratio)
 
