@@ -151,14 +151,14 @@ def _hit(hit: Hit) -> dict:
 
 
 def _table(report: dict) -> str:
-    lines = [f"{report['query']} ({report['query_length']} residues) against {report['searched']} chains: "
-             f"{report['scored']} scored by the alignment of 3Di states and amino acids, {report['aligned']} (the best "
-             f"and the nearest by pair profile) aligned by structure, in {report['seconds']:.2f} s; "
-             f"{len(report['hits'])} hits of E-value {report['max_evalue']:g} or less or TM-score 0.5 or more",
-             "TM-score normalised by the query (and by the hit); below 0.5 the folds differ; E-value: the unrelated "
-             "chains expected to score as high",
-             f"{'rank':>4}  {'entry':<12} {'chain':<6}{'length':>7}{'E-value':>10}{'bits':>7}{'TM-score':>10}"
-             f"{'(hit)':>8}{'aligned':>9}{'rms Å':>8}{'identity':>10}"]
+    lines = [(f"{report['query']} ({report['query_length']} residues) against {report['searched']} chains: "
+              f"{report['scored']} scored by the alignment of 3Di states and amino acids, {report['aligned']} (the best "
+              f"and the nearest by pair profile) aligned by structure, in {report['seconds']:.2f} s; "
+              f"{len(report['hits'])} hits of E-value {report['max_evalue']:g} or less or TM-score 0.5 or more"),
+             ("TM-score normalised by the query (and by the hit); below 0.5 the folds differ; E-value: the unrelated "
+              "chains expected to score as high"),
+             (f"{'rank':>4}  {'entry':<12} {'chain':<6}{'length':>7}{'E-value':>10}{'bits':>7}{'TM-score':>10}"
+              f"{'(hit)':>8}{'aligned':>9}{'rms Å':>8}{'identity':>10}")]
     for rank, hit in enumerate(report["hits"], 1):
         line = (f"{rank:>4}  {hit['entry']:<12} {hit['chain']:<6}{hit['length']:>7}{hit['evalue']:>10.2g}"
                 f"{hit['bits']:>7.1f}")
