@@ -86,19 +86,15 @@ def read_trace(path: Path, model: int = 1) -> Trace | None:
     """The trace of model ``model`` (from 1) of the structure file ``path``; None where it has no
     polymer of two connected residues, is larger than :data:`LARGEST_SKETCHED` or cannot be read
     (reading it in full says why)."""
-    import gemmi  # (here: the window's frame is painted before it loads)
+    from core.protein.parsing import parse  # (here: the window's frame is painted before gemmi loads)
 
     try:
         if path.stat().st_size > LARGEST_SKETCHED:
             return None
         text = text_of(path, read_bytes(path))[0]
-        if looks_like_mmcif(text):
-            st = gemmi.make_structure_from_block(gemmi.cif.read_string(text)[0])
-        else:
-            st = gemmi.read_pdb_string(text)
+        st = parse(text, "mmcif" if looks_like_mmcif(text) else "pdb", path)
         if not 1 <= model <= len(st):
             return None
-        st.setup_entities()
         chosen = st[model - 1]
         runs = _runs(chosen, _secondary_structure(st, chosen))
         looked_at = [p for run in runs if run.kinds[0] != "N" for p in run.positions]

@@ -16,6 +16,7 @@ import gemmi
 import numpy as np
 
 from core.protein.input_files import StructureError, looks_like_mmcif, read_bytes, text_of
+from core.protein.parsing import info, parse
 from core.protein.scanning import ScannedModel, scan_model
 from core.protein.segments import (
     atom_residue,
@@ -68,7 +69,7 @@ def read_structure(
         path=path,
         source_format=fmt,
         entry_id=st.name,
-        title=_info(st, "_struct.title"),
+        title=info(st, "_struct.title"),
         coords=frozen(atoms.coords),
         atom_residue=frozen(atom_residue(len(atoms.coords), groups, rows)),
         segments=segments,
@@ -111,7 +112,9 @@ def _parsed(path: Path, data: bytes, model: int) -> tuple[str, str, str, gemmi.S
     """Text, its encoding, format and parsed structure of a file that has model ``model`` (from 1)."""
     text, encoding = text_of(path, data)
     fmt = "mmcif" if looks_like_mmcif(text) else "pdb"
-    st = _parse(text, fmt, path)
+    if fmt == "pdb":
+        _check_coordinate_fields(text, path)
+    st = parse(text, fmt, path)
     if isinstance(model, bool) or not isinstance(model, (int, np.integer)) or not 1 <= model <= len(st):
         raise StructureError(f"{path}: no model {model!r}; the file has {len(st)} model(s), "
                              f"numbered 1 to {len(st)} in file order")
@@ -159,27 +162,6 @@ def _atom_table(entry_id: str, atoms: ScannedModel) -> AtomTable:
     )
 
 
-def _parse(text: str, fmt: str, path: Path) -> gemmi.Structure:
-    """gemmi.Structure of ``text`` with entities set up and ``name`` set to the entry id."""
-    if fmt == "pdb":
-        _check_coordinate_fields(text, path)
-    try:
-        if fmt == "mmcif":
-            block = gemmi.cif.read_string(text)[0]
-            _fill_author_columns(block)
-            st = gemmi.make_structure_from_block(block)
-        else:
-            st = gemmi.read_pdb_string(text)
-    except (RuntimeError, ValueError, IndexError) as exc:
-        kind = "mmCIF" if fmt == "mmcif" else "PDB"
-        raise StructureError(f"{path}: not a readable {kind} file ({exc})") from None
-    if len(st) == 0:
-        raise StructureError(f"{path}: not a structure file (no atoms found)")
-    st.setup_entities()
-    st.name = _info(st, "_entry.id") or path.name.split(".")[0]
-    return st
-
-
 def _check_coordinate_fields(text: str, path: Path) -> None:
     """Refuse a PDB atom record whose x, y or z (columns 31-54) is not a number: gemmi would
     read it as 0.000, and every command would compute on an invented position."""
@@ -192,40 +174,3 @@ def _check_coordinate_fields(text: str, path: Path) -> None:
                 except ValueError:
                     raise StructureError(f"{path}: line {number}: the {axis} coordinate {field.strip()!r} "
                                          f"(columns {start + 1}-{start + 8}) is not a number") from None
-
-
-_LABEL_OF = {"auth_asym_id": "label_asym_id", "auth_comp_id": "label_comp_id", "auth_atom_id": "label_atom_id"}
-
-
-def _fill_author_columns(block: gemmi.cif.Block) -> None:
-    """Author columns of ``_atom_site`` that a file lacks, taken from its ``label_*`` columns
-    (what the author numbering is, when there is none). A residue without ``label_seq_id``
-    (ligands, waters) is numbered within its ``label_asym_id`` in file order: a new one starts
-    where the chemical component changes or an atom name comes again."""
-    tags = {tag.removeprefix("_atom_site.") for tag in block.find_mmcif_category("_atom_site.").tags}
-    if not tags or all(tag in tags for tag in ("auth_seq_id", *_LABEL_OF)):
-        return  # the usual file: nothing to fill
-    table = block.get_mmcif_category("_atom_site.")
-    for auth, label in _LABEL_OF.items():
-        if auth not in table and label in table:
-            table[auth] = list(table[label])
-    if "auth_seq_id" not in table and "label_seq_id" in table:
-        numbers, seen, previous, counter = [], set(), None, {}
-        for asym, seq, comp, atom, alt in zip(table["label_asym_id"], table["label_seq_id"], table["label_comp_id"],
-                                              table["label_atom_id"], table.get("label_alt_id") or
-                                              [None] * len(table["label_seq_id"]), strict=True):
-            if seq is not None and seq is not False:
-                numbers.append(seq)
-                continue
-            key = (asym, comp)
-            if key != previous or (atom, alt) in seen:
-                counter[asym] = counter.get(asym, 0) + 1
-                seen, previous = set(), key
-            seen.add((atom, alt))
-            numbers.append(str(counter[asym]))
-        table["auth_seq_id"] = numbers
-    block.set_mmcif_category("_atom_site.", table)
-
-
-def _info(st: gemmi.Structure, key: str) -> str:
-    return st.info[key] if key in st.info else ""
