@@ -109,8 +109,10 @@ def run_search(args: argparse.Namespace) -> int:
     if residues < MIN_RESIDUES:  # (its TM-scores and E-values would mean little; the index holds none either)
         raise InputError(f"{path}: chain {chain} has {residues} residue(s): a fold search needs a chain of "
                          f"{MIN_RESIDUES} or more (a peptide has no fold to search)")
-    if not args.index.is_file():
+    if not args.index.exists():
         raise InputError(f"{args.index}: no such file")
+    if not args.index.is_file():
+        raise InputError(f"{args.index}: not a regular file (a folder, device or FIFO is not a fold index)")
     try:
         index = FoldIndex.read(args.index)
     except ValueError as error:

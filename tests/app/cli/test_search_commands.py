@@ -137,6 +137,7 @@ def test_the_index_given_first_is_named_as_such(index_file, capsys):
         (["index", "{data}/1BNA.pdb.gz", "-o", "{tmp}/x.npz"], "no protein chain of 20 residues or more"),
         (["index", "{data}/1UBQ.pdb.gz", "-o", "{tmp}/missing/x.npz"], "no such folder"),
         (["search", "{data}/1UBQ.pdb.gz", "{tmp}/none.npz"], "no such file"),
+        (["search", "{data}/1UBQ.pdb.gz", "{tmp}"], "not a regular file (a folder"),
         (["search", "{data}/1UBQ.pdb.gz", "{data}/1UBQ.pdb.gz"], "not a ribbonwave fold index"),
         (["search", "{data}/1UBQ.pdb.gz:Z", "{data}/1UBQ.pdb.gz"], "no protein chain 'Z'"),
         (["search", "{data}/nothing.pdb", "{data}/1UBQ.pdb.gz"], "no such file"),
