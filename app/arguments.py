@@ -1,11 +1,16 @@
 """Argument types with their sane ranges, for every command: a value outside is a usage error
-(exit status 2) whose message gives the range, before any work starts."""
+(exit status 2) whose message gives the range, before any work starts; and the check of an
+output file before any work (:func:`writable_output`)."""
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
 from collections.abc import Callable
+from pathlib import Path
+
+from app.errors import InputError
 
 LEVEL = (0.0, 30.0)
 """Carson levels: log2 of a segment's residues stays far below 30."""
@@ -42,3 +47,16 @@ def bounded_list(low: int, high: int) -> Callable[[str], tuple[int, ...]]:
         return values
     parse.__name__ = "list"
     return parse
+
+
+def writable_output(path: Path, overwrite: bool) -> None:
+    """Refuse, before any work, an output file a command could not write at the end: a folder,
+    a file that exists (unless ``overwrite``), or a missing or read-only folder (:class:`InputError`)."""
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder")
+    if (path.exists() or path.is_symlink()) and not overwrite:
+        raise InputError(f"{path}: refusing to overwrite an existing file (use --overwrite)")
+    if not path.parent.is_dir():
+        raise InputError(f"{path}: no such folder {path.parent}")
+    if not os.access(path.parent, os.W_OK | os.X_OK):
+        raise InputError(f"{path.parent}: cannot write in the folder (permission denied)")

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 import zipfile
@@ -20,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from app.arguments import bounded
+from app.arguments import bounded, writable_output
 from app.cli.batch import batch_arguments, run_tasks, structure_paths
 from app.cli.structure import load
 from app.errors import InputError
@@ -41,14 +40,7 @@ def index_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run_index(args: argparse.Namespace) -> int:
     output: Path = args.output
-    if (output.exists() or output.is_symlink()) and not args.overwrite:
-        raise InputError(f"{output}: refusing to overwrite an existing file (use --overwrite)")
-    if output.is_dir():
-        raise InputError(f"{output}: is a folder")
-    if not output.parent.is_dir():
-        raise InputError(f"{output}: no such folder {output.parent}")
-    if not os.access(output.parent, os.W_OK | os.X_OK):
-        raise InputError(f"{output.parent}: cannot write in the folder (permission denied)")
+    writable_output(output, args.overwrite)
     paths = structure_paths(args.paths)
     start = time.perf_counter()
     found: dict[int, FoldIndex] = {}

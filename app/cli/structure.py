@@ -7,14 +7,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 
-from app.arguments import bounded
+from app.arguments import bounded, writable_output
 from app.errors import InputError
 from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
@@ -38,17 +37,9 @@ def load(path: Path, model: int = 1) -> Structure:
 
 
 def checked_output(path: Path, overwrite: bool) -> None:
-    """Refuse, before any work, an output file the command could not write at the end: one
-    that exists (unless ``overwrite``), a folder, a missing or read-only folder, or (for a
-    structure) an unknown extension."""
-    if path.is_dir():
-        raise InputError(f"{path}: is a folder")
-    if (path.exists() or path.is_symlink()) and not overwrite:
-        raise InputError(f"{path}: refusing to overwrite an existing file (pass --overwrite to replace it)")
-    if not path.parent.is_dir():
-        raise InputError(f"{path}: no such folder {path.parent}")
-    if not os.access(path.parent, os.W_OK | os.X_OK):
-        raise InputError(f"{path.parent}: cannot write in the folder (permission denied)")
+    """Refuse, before any work, a structure file the command could not write at the end
+    (:func:`~app.arguments.writable_output`) or of an unknown extension."""
+    writable_output(path, overwrite)
     try:
         output_format(path)
     except StructureError as error:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from app.arguments import bounded
+from app.arguments import bounded, writable_output
 from app.cli.structure import model_argument
 from app.errors import InputError
 from app.polydata import scalar_style, to_polydata
@@ -63,10 +63,7 @@ def run_surface(args: argparse.Namespace) -> int:
     suffix = args.output.suffix.lower()
     if suffix not in OUTPUTS:
         raise InputError(f"{args.output}: unknown output type; use {', '.join(OUTPUTS)}")
-    if (args.output.exists() or args.output.is_symlink()) and not args.overwrite:
-        raise InputError(f"{args.output}: refusing to overwrite an existing file (use --overwrite)")
-    if not args.output.parent.is_dir():
-        raise InputError(f"{args.output}: no such folder {args.output.parent}")
+    writable_output(args.output, args.overwrite)
     if (args.file is None) == (args.ideal_dna is None):
         raise InputError("give either FILE or --ideal-dna N")
     if args.site is not None and args.kind != "remesh":

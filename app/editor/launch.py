@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TypeVar
 
 from app import DEFAULT_STRUCTURE, PROG
-from app.arguments import IMAGE_SIDE, LEVEL, SUPERSAMPLING, bounded
+from app.arguments import IMAGE_SIDE, LEVEL, SUPERSAMPLING, bounded, writable_output
 from app.errors import InputError
 
 if TYPE_CHECKING:
@@ -163,7 +163,7 @@ def run_open(args: argparse.Namespace) -> int:
     script = _read_script(args.script) if args.script is not None else None
     images = [path for path in (args.screenshot, args.export_image) if path is not None]
     for path in images:
-        _check_output(path, args.overwrite)
+        writable_output(path, args.overwrite)
     from app.editor.persistence.folder import checked_folder, state_folder
 
     try:
@@ -348,14 +348,6 @@ def _check_display() -> None:
                                  "answers there (or it refuses this user); run under xvfb-run")
             xlib.XCloseDisplay.argtypes = [ctypes.c_void_p]
             xlib.XCloseDisplay(handle)
-
-
-def _check_output(path: Path, overwrite: bool) -> None:
-    """Refuse, before any work, an output file that exists (unless ``overwrite``) or whose folder does not."""
-    if (path.exists() or path.is_symlink()) and not overwrite:
-        raise InputError(f"{path}: refusing to overwrite an existing file (use --overwrite)")
-    if not path.parent.is_dir():
-        raise InputError(f"{path}: no such folder {path.parent}")
 
 
 def _read_script(path: Path) -> str:

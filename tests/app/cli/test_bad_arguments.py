@@ -44,6 +44,21 @@ def test_output_folder_is_checked_before_the_input_is_read(capsys, tmp_path):
     assert capsys.readouterr().err == f"ribbonwave: error: {out}: no such folder {out.parent}\n"
 
 
+@pytest.mark.parametrize("command", [
+    ["surface", UBQ, "-o", "{out}"],
+    ["index", UBQ, "-o", "{out}", "--overwrite"],
+    ["index", UBQ, "-o", "{out}"],
+    ["edit", UBQ, "--chain", "A", "--level", "3", "--point", "1", "--move", "1,0,0", "-o", "{out}", "--overwrite"],
+    [UBQ, "--screenshot", "{out}", "--overwrite"],
+])
+def test_every_command_refuses_a_folder_as_its_output_file_before_any_work(command, capsys, tmp_path):
+    out = tmp_path / "shot.png" if command[0] == UBQ else tmp_path / "out.vtp"
+    out.mkdir()
+    assert main([part.replace("{out}", str(out)) for part in command]) == 1
+    assert capsys.readouterr().err == f"ribbonwave: error: {out}: is a folder\n"
+    assert list(out.iterdir()) == []
+
+
 def test_negative_residue_ranges_are_values_not_options(capsys):
     status = main(["compare", str(DATA / "3PTB.pdb.gz"), str(DATA / "1BMA.pdb.gz"), "--core", "-45--30"])
     assert status == 1 and "--core: no residue '-45--30' in chain" in capsys.readouterr().err  # read as a range

@@ -50,7 +50,7 @@ def test_fit_json_and_refusals(capsys, tmp_path: Path) -> None:
     assert [level["level"] for level in report["levels"]] == list(range(7))
     assert report["final"] <= 1.5 and report["validation"]["peptide_bond"]["after"] <= MIN_MARGIN
     status, _, err = run(capsys, "fit", OPEN, "--to", CLOSED, "-o", out)
-    assert status == 1 and "pass --overwrite" in err
+    assert status == 1 and "refusing to overwrite an existing file (use --overwrite)" in err
     status, _, err = run(capsys, "fit", OPEN, "--to", DATA / "1UBQ.pdb.gz", "-o", tmp_path / "x.pdb")
     assert status == 1 and "another fold" in err and not (tmp_path / "x.pdb").exists()
     status, _, err = run(capsys, "fit", OPEN, "--to", CLOSED, "--chain", "Q", "-o", tmp_path / "y.pdb")
