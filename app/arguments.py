@@ -1,6 +1,6 @@
 """Argument types with their sane ranges, for every command: a value outside is a usage error
 (exit status 2) whose message gives the range, before any work starts; and the check of an
-output file before any work (:func:`writable_output`)."""
+output file before any work (:func:`writable_output`); a file named with its chain (:func:`file_and_chain`)."""
 
 from __future__ import annotations
 
@@ -60,3 +60,22 @@ def writable_output(path: Path, overwrite: bool) -> None:
         raise InputError(f"{path}: no such folder {path.parent}")
     if not os.access(path.parent, os.W_OK | os.X_OK):
         raise InputError(f"{path.parent}: cannot write in the folder (permission denied)")
+
+
+def file_and_chain(spec: str) -> tuple[Path, str | None]:
+    """``FILE`` or ``FILE:CHAIN``: a chain only where ``spec`` names no file and ``FILE`` does (a
+    file whose name has a colon is taken whole)."""
+    path = Path(spec)
+    if not path.exists() and ":" in spec:
+        name, chain = spec.rsplit(":", 1)
+        if chain and Path(name).is_file():
+            return Path(name), chain
+    return path, None
+
+
+def chain_hint(path: Path) -> str:
+    """What to add to "no such file" where ``path`` is ``FILE:CHAIN`` given to a command that
+    takes a file alone ('' for any other path)."""
+    named, chain = file_and_chain(str(path))
+    return "" if chain is None else (f" (this command takes no chain after a colon: give {named}, and see --help "
+                                     "for a chain option)")

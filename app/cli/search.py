@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from app.arguments import bounded, writable_output
+from app.arguments import bounded, file_and_chain, writable_output
 from app.cli.batch import batch_arguments, run_tasks, structure_paths
 from app.cli.structure import load
 from app.errors import InputError
@@ -87,7 +87,7 @@ def search_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run_search(args: argparse.Namespace) -> int:
-    path, chain = _query(args.query)
+    path, chain = file_and_chain(args.query)
     if zipfile.is_zipfile(path):  # (an index is a zip archive; no structure file is)
         raise InputError(f"{path}: a fold index, not a structure: give the query's structure first, then the index "
                          "(ribbonwave search QUERY DB)")
@@ -161,16 +161,6 @@ def _table(report: dict) -> str:
                      f"{100 * hit['identity']:>9.1f}%")
         lines.append(line)
     return "\n".join(lines)
-
-
-def _query(text: str) -> tuple[Path, str | None]:
-    """``FILE`` or ``FILE:CHAIN`` (a file whose name has a colon is taken whole when it exists)."""
-    if Path(text).exists() or ":" not in text:
-        return Path(text), None
-    path, chain = text.rsplit(":", 1)
-    if not chain:
-        raise InputError(f"{text}: expected FILE or FILE:CHAIN")
-    return Path(path), chain
 
 
 def _longest_chain(structure: Structure) -> str:

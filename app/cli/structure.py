@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from app.arguments import bounded, writable_output
+from app.arguments import bounded, chain_hint, writable_output
 from app.errors import InputError
 from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
@@ -30,7 +30,7 @@ def load(path: Path, model: int = 1) -> Structure:
     try:
         structure = read_structure(path, model=model)
     except StructureError as error:
-        raise InputError(str(error)) from None
+        raise InputError(str(error) + chain_hint(path)) from None
     for warning in structure.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     return structure

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TypeVar
 
 from app import DEFAULT_STRUCTURE, PROG
-from app.arguments import IMAGE_SIDE, LEVEL, SUPERSAMPLING, bounded, writable_output
+from app.arguments import IMAGE_SIDE, LEVEL, SUPERSAMPLING, bounded, chain_hint, file_and_chain, writable_output
 from app.errors import InputError
 
 if TYPE_CHECKING:
@@ -258,7 +258,7 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
         try:
             window.document.open(args.file, args.ribbon, model=args.model, assembly=args.assembly)
         except StructureError as error:
-            raise InputError(str(error)) from error
+            raise InputError(str(error) + chain_hint(args.file)) from error
         if args.file != DEFAULT_STRUCTURE:
             window.files.add_recent(args.file)
     if args.level is not None:
@@ -273,7 +273,7 @@ def _load(window: MainWindow, args: argparse.Namespace) -> None:
             raise InputError(f"--hide: no layer {name!r}; layers: {names}")
         window.display_panel.layer_boxes[layer].setChecked(False)
     for spec in args.compare:
-        path, chain = _file_and_chain(spec)
+        path, chain = file_and_chain(spec)
         try:
             window.comparison.add(path, chain)
         except (StructureError, ValueError) as error:
@@ -383,13 +383,3 @@ def _run_script(window: MainWindow, path: Path, text: str) -> int:
         traceback.print_exception(type(error), error, tb)
         return 1
     return 0
-
-
-def _file_and_chain(spec: str) -> tuple[Path, str | None]:
-    """``FILE`` or ``FILE:CHAIN`` (a chain only when ``FILE`` itself does not exist)."""
-    path = Path(spec)
-    if not path.exists() and ":" in spec:
-        name, chain = spec.rsplit(":", 1)
-        if chain and Path(name).exists():
-            return Path(name), chain
-    return path, None

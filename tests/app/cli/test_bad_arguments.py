@@ -59,6 +59,15 @@ def test_every_command_refuses_a_folder_as_its_output_file_before_any_work(comma
     assert list(out.iterdir()) == []
 
 
+@pytest.mark.parametrize("command", [["info", UBQ + ":A"], ["compare", UBQ + ":A", UBQ], ["curve", UBQ + ":A"],
+                                     [UBQ + ":A", "--screenshot", "shot.png"]])
+def test_a_chain_after_a_colon_is_pointed_to_the_file_and_the_options(command, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(command) == 1
+    assert capsys.readouterr().err == (f"ribbonwave: error: {UBQ}:A: no such file (this command takes no chain "
+                                       f"after a colon: give {UBQ}, and see --help for a chain option)\n")
+
+
 def test_negative_residue_ranges_are_values_not_options(capsys):
     status = main(["compare", str(DATA / "3PTB.pdb.gz"), str(DATA / "1BMA.pdb.gz"), "--core", "-45--30"])
     assert status == 1 and "--core: no residue '-45--30' in chain" in capsys.readouterr().err  # read as a range
