@@ -1,6 +1,7 @@
-"""Argument types with their sane ranges, for every command: a value outside is a usage error
-(exit status 2) whose message gives the range, before any work starts; and the check of an
-output file before any work (:func:`writable_output`); a file named with its chain (:func:`file_and_chain`)."""
+"""What every command checks of its arguments before any work starts: numbers within their sane
+ranges (a value outside is a usage error, exit status 2, whose message gives the range), an
+output file it can write (:func:`writable_output`), and a file named with its chain
+(:func:`file_and_chain`)."""
 
 from __future__ import annotations
 
