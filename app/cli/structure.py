@@ -24,11 +24,12 @@ MAX_MODEL = 100_000
 """Largest ``--model`` accepted before the file is read (PDB model serials stop at 9999)."""
 
 
-def load(path: Path, model: int = 1) -> Structure:
+def load(path: Path, model: int = 1, require_protein: bool = True) -> Structure:
     """Read model ``model`` (from 1) of a structure, turning reader errors (a model the file
-    does not have included) into :class:`InputError`; print its warnings."""
+    does not have included; no protein chain, unless not ``require_protein``) into
+    :class:`InputError`; print its warnings."""
     try:
-        structure = read_structure(path, model=model)
+        structure = read_structure(path, model=model, require_protein=require_protein)
     except StructureError as error:
         raise InputError(str(error) + chain_hint(path)) from None
     for warning in structure.warnings:
@@ -63,7 +64,8 @@ def info_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def summary(structure: Structure) -> dict:
-    """Chains, segments, residues, secondary structure and maximum levels of a structure."""
+    """Chains (with their nucleotides), segments, residues, secondary structure and maximum
+    levels of a structure."""
     segments = []
     for number, segment in enumerate(structure.segments):
         segments.append({
@@ -75,7 +77,7 @@ def summary(structure: Structure) -> dict:
             "max_level_peptide": round(float(np.log2(len(segment))), 4),
             "max_level_calpha": round(float(np.log2(len(segment) + 1)), 4),
         })
-    ss = Counter(np.concatenate([s.ss for s in structure.segments]).tolist())
+    ss = Counter(code for s in structure.segments for code in s.ss.tolist())
     return {
         "file": str(structure.path),
         "format": structure.source_format,
@@ -88,7 +90,8 @@ def summary(structure: Structure) -> dict:
         "water_atoms": structure.n_water_atoms,
         "altloc_atoms": structure.n_altloc_atoms,
         "chains": [
-            {"chain": c.name, "residues": c.n_residues, "backbone_residues": c.n_backbone, "segments": c.n_segments}
+            {"chain": c.name, "residues": c.n_residues, "backbone_residues": c.n_backbone, "segments": c.n_segments,
+             "nucleotides": c.n_nucleotides, "nucleic_acid": c.nucleic_acid}
             for c in structure.chains
         ],
         "segments": segments,
@@ -100,7 +103,7 @@ def summary(structure: Structure) -> dict:
 
 
 def run_info(args: argparse.Namespace) -> int:
-    report = summary(load(args.file, args.model))
+    report = summary(load(args.file, args.model, require_protein=False))
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
@@ -109,6 +112,14 @@ def run_info(args: argparse.Namespace) -> int:
     print(f"  {report['atoms']} atoms ({report['hetero_atoms']} hetero, {report['water_atoms']} water, "
           f"{report['altloc_atoms']} with altlocs); "
           + (f"model {report['model']} of {report['models']}" if report["models"] > 1 else "1 model"))
+    nucleic = [c for c in report["chains"] if c["nucleotides"]]
+    if nucleic:
+        print("  nucleic acids: " + ", ".join(f"chain {c['chain']} {c['nucleotides']} nucleotides"
+                                              + (f" ({c['nucleic_acid']})" if c["nucleic_acid"] else "")
+                                              for c in nucleic))
+    if not report["segments"]:
+        print("  no protein chain: no ribbon to decompose (the editor shows the entry)")
+        return 0
     print(f"  {report['residues']} backbone residues: {ss['H']} helix, {ss['E']} sheet, {ss['C']} other "
           f"(from {report['secondary_structure_source']})")
     print(f"  {'chain':<6}{'seg':>4}  {'residues':>8}  {'from':<14}{'to':<14}{'max level':>10}")

@@ -11,6 +11,7 @@ import numpy as np
 
 _BACKBONE = ("N", "CA", "C", "O")
 _PEPTIDE = (gemmi.PolymerType.PeptideL, gemmi.PolymerType.PeptideD)
+_NUCLEIC = (gemmi.PolymerType.Dna, gemmi.PolymerType.Rna, gemmi.PolymerType.DnaRnaHybrid)
 _POLYMER_ELEMENTS = frozenset({"H", "D", "C", "N", "O", "S", "P", "Se"})
 """The elements of standard amino acids and nucleotides. A file without element columns
 (CHARMM and NAMD write such) leaves gemmi to guess from names: CA as calcium, HG1 as mercury."""
@@ -64,7 +65,8 @@ def scan_model(model: gemmi.Model) -> ScannedModel:
     nucleotide: dict[str, bool] = {}
     standard: dict[str, bool] = {}
     for k, ch in enumerate(model):
-        peptide_chain = ch.get_polymer().check_polymer_type() in _PEPTIDE
+        polymer_type = ch.get_polymer().check_polymer_type()
+        peptide_chain, nucleic_chain = polymer_type in _PEPTIDE, polymer_type in _NUCLEIC
         for res in ch:
             if res.name not in amino_acid:
                 tabulated = gemmi.find_tabulated_residue(res.name)
@@ -94,7 +96,7 @@ def scan_model(model: gemmi.Model) -> ScannedModel:
             elif res.het_flag == "H":
                 n_hetero += len(res)
             polymer = res.entity_type == gemmi.EntityType.Polymer
-            nucleic.append(polymer and nucleotide[res.name])
+            nucleic.append(polymer and (nucleotide[res.name] or nucleic_chain and not amino_acid[res.name]))
             water.append(res.is_water())
             chain.append(ch.name)
             part.append(k)

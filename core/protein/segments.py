@@ -181,12 +181,29 @@ def atom_residue(n_atoms: int, groups: Groups, rows: np.ndarray) -> np.ndarray:
 
 def chain_summaries(atoms: ScannedModel, segments: tuple[BackboneSegment, ...]) -> tuple[ChainSummary, ...]:
     names = list(dict.fromkeys(atoms.chain))
+    nucleotides: dict[str, list[str]] = {name: [] for name in names}
+    for name, resname, nucleic in zip(atoms.chain, atoms.resname, atoms.nucleic, strict=True):
+        if nucleic:
+            nucleotides[name].append(resname)
     return tuple(
         ChainSummary(
             name=name,
             n_residues=atoms.chain.count(name),
             n_backbone=sum(len(s) for s in segments if s.chain == name),
             n_segments=sum(1 for s in segments if s.chain == name),
+            n_nucleotides=len(nucleotides[name]),
+            nucleic_acid=_nucleic_acid_kind(nucleotides[name]),
         )
         for name in names
     )
+
+
+def _nucleic_acid_kind(resnames: list[str]) -> str:
+    """'DNA', 'RNA' or 'DNA/RNA' by the kinds of nucleotide names gemmi tabulates (DA is DNA,
+    A and PSU are RNA); '' where none of the names is of a known kind."""
+    kinds = set()
+    for name in set(resnames):
+        tabulated = gemmi.find_tabulated_residue(name)
+        if tabulated is not None and tabulated.kind in (gemmi.ResidueKind.DNA, gemmi.ResidueKind.RNA):
+            kinds.add("DNA" if tabulated.kind == gemmi.ResidueKind.DNA else "RNA")
+    return "/".join(sorted(kinds))

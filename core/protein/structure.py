@@ -31,7 +31,7 @@ Conventions
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cache, cached_property
 from pathlib import Path
 
 import gemmi
@@ -117,6 +117,16 @@ def _one_letter(name: str) -> str:
     return code if code.strip() else "X"
 
 
+@cache
+def nucleotide_letter(name: str) -> str:
+    """A nucleotide's one-letter code by its residue name: A, C, G, T, U (I: inosine) for the
+    standard ones, its parent's in lower case for a modified one gemmi tabulates (PSU u,
+    5CM c), N (any nucleotide) for another."""
+    residue = gemmi.find_tabulated_residue(name.strip())
+    code = residue.one_letter_code if residue is not None else " "
+    return code if code.strip() else "N"
+
+
 @dataclass(frozen=True)
 class ChainSummary:
     """Residue counts of one chain id in the first model."""
@@ -127,6 +137,11 @@ class ChainSummary:
     n_backbone: int
     """Residues in backbone segments."""
     n_segments: int
+    n_nucleotides: int = 0
+    """Polymer nucleotides (DNA or RNA)."""
+    nucleic_acid: str = ""
+    """'DNA', 'RNA' or 'DNA/RNA' by the nucleotides' names; '' without nucleotides, or where
+    only modified nucleotides of no known kind say."""
 
 
 ATOM_CATEGORIES = ("protein", "nucleic", "ligand", "water")

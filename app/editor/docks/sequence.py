@@ -7,8 +7,9 @@ gives the residue's correlation with the map (red 0.3 or less, through yellow, t
 or more; grey where it has none). A click (or a drag across cells) asks for
 those residues to be selected and centred (:attr:`SequenceBar.residuesActivated`, which the
 window connects); Shift extends the selection. Hovering names the residue. After them come
-the letters of the entry's DNA and RNA strands, each on its base's colour and headed by its
-chain (drawn, not edited: nothing to select).
+the letters of the entry's DNA and RNA strands (a modified base in lower case, N where it
+has no known parent), each on its base's colour and headed by its chain (drawn, not edited:
+nothing to select).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from app.editor.scene.layers.control_points import PICKED_COLOUR
 from app.editor.scene.layers.selection import SELECTION_COLOUR
 from app.editor.scene.molecule import SS_COLOURS, SS_NAMES
 from app.editor.scene.nucleic import nucleotides
+from core.protein.structure import nucleotide_letter
 
 NUMBER_EVERY = 10
 STRAND_GAP = 2
@@ -84,7 +86,7 @@ class SequenceStrip(QWidget):
     def _loaded(self) -> None:
         found = nucleotides(self.document.structure.atoms) if self.document.model is not None else None
         self._strands = [] if found is None else [
-            (str(found.chain[a]), "".join(str(self.document.structure.atoms.resname[row]).strip()[-1:]
+            (str(found.chain[a]), "".join(nucleotide_letter(str(self.document.structure.atoms.resname[row]))
                                           for row in found.backbone[a:b]), found.colours[a:b])
             for a, b in zip(found.strand_start[:-1], found.strand_start[1:])]
         self._refresh()

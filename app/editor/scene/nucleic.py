@@ -1,6 +1,7 @@
 """Nucleic acids as they are drawn (numpy and scipy only): a tube through each strand's
 phosphorus atoms, and each base as a flat slab of its ring joined to the backbone by a
-stick, coloured by base (A red, G green, C yellow, T blue, U cyan, as the NDB colours them).
+stick, coloured by base (A red, G green, C yellow, T blue, U cyan, as the NDB colours them; a
+modified base as its parent, grey where it has none).
 No curve of the editor is defined on them: they are drawn, not edited."""
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import numpy as np
 from scipy.interpolate import make_interp_spline
 
 from app.editor.scene import tube
-from core.protein.structure import AtomTable
+from core.protein.structure import AtomTable, nucleotide_letter
 
 SAMPLES = 6
 """Tube rings per nucleotide."""
@@ -74,7 +75,7 @@ def nucleotides(atoms: AtomTable) -> Nucleotides:
         outline.extend(ring)
         counts.append(len(ring))
         glycosidic.append((names.get("C1'", -1), names.get("N9", names.get("N1", -1))))
-        colours.append(BASE_COLOURS.get(str(atoms.resname[group[0]]).strip()[-1:], OTHER_BASE))
+        colours.append(BASE_COLOURS.get(nucleotide_letter(str(atoms.resname[group[0]])).upper(), OTHER_BASE))
         chain.append(atoms.chain[group[0]])
     backbone_rows = np.array(backbone, dtype=np.int64)
     chain_array = np.array(chain, dtype=str)

@@ -47,6 +47,24 @@ def test_info_text_lists_every_segment_of_a_broken_chain(capsys):
         assert segment.labels[0] in out and segment.labels[-1] in out
 
 
+def test_info_names_the_nucleic_acids_and_describes_an_entry_without_protein(capsys):
+    status, out, _ = run(capsys, "info", DATA / "1BNA.pdb.gz")  # the Dickerson dodecamer: DNA only
+    assert status == 0
+    assert "chain A 12 nucleotides (DNA), chain B 12 nucleotides (DNA)" in out and "no protein chain" in out
+    status, out, _ = run(capsys, "info", DATA / "1BNA.pdb.gz", "--json")
+    report = json.loads(out)
+    assert status == 0 and report["segments"] == [] and report["residues"] == 0
+    assert [(c["chain"], c["nucleotides"], c["nucleic_acid"]) for c in report["chains"]] == [("A", 12, "DNA"),
+                                                                                           ("B", 12, "DNA")]
+    status, out, _ = run(capsys, "info", DATA / "4OPJ.pdb.gz", "--json")  # RNase H on DNA with a modified base
+    chains = {c["chain"]: c for c in json.loads(out)["chains"]}
+    assert status == 0 and chains["A"]["nucleotides"] == 0 and chains["A"]["segments"] == 1
+    assert chains["B"]["nucleotides"] == chains["D"]["nucleotides"] == 12  # its TCY counted with the 11 others
+    status, out, _ = run(capsys, "info", DATA / "1LCD.cif.gz")  # a protein beside its DNA operator
+    assert status == 0 and "nucleic acids: chain B 11 nucleotides (DNA), chain C 11 nucleotides (DNA)" in out
+    assert "A:MET1" in out
+
+
 def read_csv(text: str) -> list[dict]:
     return list(csv.DictReader(io.StringIO(text)))
 
@@ -139,7 +157,7 @@ def test_edit_never_overwrites_without_asking(capsys, tmp_path):
     "argv, message",
     [
         (["info", "missing.pdb"], "no such file"),
-        (["info", DATA / "1BNA.pdb.gz"], "no protein chain"),
+        (["curve", DATA / "1BNA.pdb.gz"], "no protein chain"),
         (["curve", DATA / "1UBQ.pdb.gz", "--chain", "Z"], "no protein chain 'Z'"),
         (["edit", DATA / "1UBQ.pdb.gz", "--chain", "A", "--level", "3", "--point", "99", "--move", "1,0,0", "-o", "x.pdb"],
          "index must be an integer in \\[0, 10\\]"),

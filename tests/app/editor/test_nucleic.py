@@ -2,6 +2,7 @@
 per base coloured by base, for a DNA duplex only viewed and beside an edited protein."""
 
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
@@ -12,6 +13,10 @@ from app.editor.scene import nucleic
 from app.editor.scene.layers.base import Layer
 from app.editor.scene.layers.chains import Others
 from app.editor.scene.layers.nucleic import NucleicLayer
+from core.protein.reading import read_structure
+from core.protein.structure import nucleotide_letter
+
+DATA = Path(__file__).resolve().parents[2] / "data"
 
 Opener = Callable[[str], MainWindow]
 
@@ -40,6 +45,21 @@ def test_a_dna_duplex_is_drawn_as_tubes_through_its_phosphates_and_slabs_per_bas
     assert not scene.actors["nucleic_tube"].GetVisibility() and not scene.actors["nucleic_bases"].GetVisibility()
 
 
+def test_a_strand_runs_on_through_its_modified_nucleotide() -> None:
+    atoms = read_structure(DATA / "4OPJ.pdb.gz").atoms  # TCY, a modified nucleotide, sixth of each 12-mer
+    found = nucleic.nucleotides(atoms)
+    assert list(found.strand_start) == [0, 12, 24]  # not broken in two at it
+    assert "TCY" in set(atoms.resname[found.backbone].tolist())
+    sixth = [int(found.backbone[start + 5]) for start in found.strand_start[:-1]]
+    assert [str(atoms.resname[row]) for row in sixth] == ["TCY", "TCY"]
+    assert [tuple(found.colours[start + 5]) for start in found.strand_start[:-1]] == [nucleic.OTHER_BASE] * 2
+
+
+def test_a_modified_nucleotide_is_lettered_and_coloured_as_its_parent() -> None:
+    letters = {name: nucleotide_letter(name) for name in ("DA", "DT", "G", "U", "PSU", "5CM", "OMG", "TCY")}
+    assert letters == {"DA": "A", "DT": "T", "G": "G", "U": "U", "PSU": "u", "5CM": "c", "OMG": "g", "TCY": "N"}
+
+
 def test_dna_beside_an_edited_protein_stays_where_it_is_and_hides_with_the_other_chains(open_window: Opener) -> None:
     window = open_window("1LCD.cif.gz")  # the lac repressor headpiece on its operator
     scene, document = window.scene, window.document
@@ -64,6 +84,12 @@ def test_the_sequence_bar_shows_the_strands_letters_on_their_bases_colours(open_
     colour = image.pixelColor(cell.left() + 2, cell.top() + 2)
     assert (colour.red(), colour.green(), colour.blue()) == _light(nucleic.BASE_COLOURS["C"])
     assert strip.sizeHint().width() >= (2 * (12 + STRAND_GAP)) * strip.cell
+
+
+def test_the_sequence_bar_letters_a_modified_nucleotide_n_within_its_strand(open_window: Opener) -> None:
+    window = open_window("4OPJ.pdb.gz")
+    strands = [(chain, letters) for chain, letters, _ in window.sequence_bar.strip._strands]
+    assert strands == [("B", "CGCGANTTCGCG"), ("D", "CGCGANTTCGCG")]
 
 
 def test_hovering_a_nucleotide_says_it_is_not_edited(open_window: Opener) -> None:

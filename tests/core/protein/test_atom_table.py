@@ -48,6 +48,16 @@ def test_read_atoms_accepts_dna_without_protein() -> None:
     assert not atoms.coords.flags.writeable and not atoms.b_factor.flags.writeable
 
 
+def test_a_modified_nucleotide_of_a_dna_strand_is_a_nucleotide() -> None:
+    structure = read_structure(DATA / "4OPJ.pdb.gz")  # two DNA strands, the sixth nucleotide of each a modified one (TCY)
+    atoms = structure.atoms
+    tcy = atoms.resname == "TCY"
+    assert tcy.any() and set(atoms.category[tcy].tolist()) == {"nucleic"}
+    assert set(atoms.category[atoms.resname == "GOL"].tolist()) == {"ligand"}  # a glycerol stays a ligand
+    strands = {c.name: (c.n_nucleotides, c.nucleic_acid) for c in structure.chains}
+    assert strands == {"A": (0, ""), "B": (12, "DNA"), "C": (0, ""), "D": (12, "DNA")}
+
+
 def test_altlocs_are_recorded() -> None:
     atoms = read_structure(DATA / "1EJG.pdb.gz").atoms
     assert {"", "A", "B"} <= set(atoms.altloc.tolist())
