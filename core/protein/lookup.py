@@ -1,12 +1,14 @@
 """Residues named as people type them: ``A:45``, ``45``, ``A45``, ``A:LYS45``, ``A:52A``,
-``A:40-50``; as ChimeraX specifies them (``/A:45-50``, ``:45``, ``#1/A:45``, ``/A``); and as
-PyMOL selects them (``chain A and resi 45-50``, ``resi 45``, ``c. A & i. 45``, ``/obj//A/45``,
-``A/45/``, ``A/LYS`45/CA``)."""
+``A:40-50``, lists of these (``A:40-42, B:45, 50``); as ChimeraX specifies them (``/A:45-50``,
+``:45``, ``#1/A:45``, ``/A``, lists ``/A,B:40-42,50 /C:7``); and as PyMOL selects them
+(``chain A and resi 45-50``, ``resi 45``, ``c. A & i. 45``, lists ``chain A+B and resi 40-42+50``,
+``/obj//A/45``, ``A/45/``, ``A/LYS`45/CA``)."""
 
 from __future__ import annotations
 
+import itertools
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -18,8 +20,10 @@ _OWN = re.compile(rf"(?:(?P<chain>{_CHAIN})\s*[:/]\s*|(?P<letter>[A-Za-z])(?=-?\
 _CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{_CHAIN}))?\s*(?::{_NUMBERS})?")
 _PYMOL_RESI = re.compile(rf"(?:(?P<name>[A-Za-z]{{3}})`)?{_NUMBERS}")
 _PYMOL_WORDS = {"chain": "chain", "c.": "chain", "resi": "resi", "i.": "resi", "resn": "resn", "r.": "resn"}
-HELP = ("type e.g. A:45, 45 or A:40-50; ChimeraX /A:45-50 or :45; PyMOL chain A and resi 45-50, resi 45, "
-        "/obj//A/45 or A/45/")
+HELP = ("type e.g. A:45, 45, A:40-50 or A:40-42, B:45; ChimeraX /A:45-50,60 or :45; PyMOL chain A and resi "
+        "45-50+60, resi 45, /obj//A/45 or A/45/")
+MAX_PARTS = 10_000
+"""Most parts (a residue, range or chain each) a list may name."""
 
 
 @dataclass(frozen=True)
@@ -41,13 +45,22 @@ class _Named:
 
 
 def find_residues(structure: Structure, text: str, chain: str | None = None) -> np.ndarray:
-    """Residue-table rows named by ``text``: one residue (``A:45``, ``45``, ``A45``, ``A:LYS45``,
-    ``A:52A``), a range (``A:40-50``) or a whole chain (``/A``, ``chain A``), in any syntax of
-    the module's, in ``chain`` when the text names none (any chain when ``chain`` is None, the
-    first that has it). Raises ValueError naming what is missing or how to type it."""
-    named = _read(text.strip())
-    if named is None:
+    """Residue-table rows named by ``text``, in increasing order: one residue (``A:45``, ``45``,
+    ``A45``, ``A:LYS45``, ``A:52A``), a range (``A:40-50``), a whole chain (``/A``, ``chain A``)
+    or a list of them (``A:40-42, B:45``, ``/A:40-42,50``, ``resi 40-42+50``), in any syntax of
+    the module's; a part names ``chain`` when neither it nor a part before it in its list names
+    one (any chain when ``chain`` is None, the first that has it). Raises ValueError naming what
+    is missing or how to type it."""
+    parts = _read_all(text.strip())
+    if parts is None:
         raise ValueError(f"cannot read {text.strip()!r} as residues: {HELP}")
+    if len(parts) == 1:
+        return _rows(structure, *parts[0], chain)
+    return np.unique(np.concatenate([_rows(structure, part, named, chain) for part, named in parts]))
+
+
+def _rows(structure: Structure, text: str, named: _Named, chain: str | None) -> np.ndarray:
+    """The rows of one residue, range or chain, ``named`` by ``text``."""
     chains = [s.chain for s in structure.segments]
     if named.chain is not None and named.chain not in chains:
         known = ", ".join(chain or "none (the file names no chain)" for chain in dict.fromkeys(chains))
@@ -102,6 +115,42 @@ def _atom_parts(text: str) -> tuple[str, str]:
 def _label(structure: Structure, row: int) -> str:
     segment = next(s for s in structure.segments if s.residue_index[0] <= row <= s.residue_index[-1])
     return str(segment.labels[row - segment.residue_index[0]])
+
+
+def _read_all(text: str) -> list[tuple[str, _Named]] | None:
+    """Each part ``text`` names, with its own text: one as :func:`_read` reads it, else a list,
+    ChimeraX's (specs apart by spaces, chains and residues by commas), PyMOL's (values joined
+    by ``+``) or this module's (parts apart by commas), a part without a chain in the chain of
+    the part before it; None where a part is unreadable. ValueError past :data:`MAX_PARTS`."""
+    if (named := _read(text)) is not None:
+        return [(text, named)]
+    if text.startswith(("/", "#", ":")):
+        specs = [re.fullmatch(r"(?:#[\d.]+)?(?:/(?P<chains>[^:]+))?(?::(?P<residues>.+))?", spec)
+                 for spec in text.split()]
+        if any(match is None or not (match["chains"] or match["residues"]) for match in specs):
+            return None
+        choices = [[[f"/{c}" if c else "" for c in (match["chains"] or "").split(",")],
+                    [f":{r}" if r else "" for r in (match["residues"] or "").split(",")]] for match in specs]
+        join = ""
+    elif "+" in text:
+        terms = [term.strip().partition(" ") for term in re.split(r"\s+and\s+|\s*&\s*", text, flags=re.IGNORECASE)]
+        choices = [[[f"{word} {value.strip()}" for value in values.split("+")] for word, _, values in terms]]
+        join = " and "
+    else:
+        choices, join = [[[part.strip()]] for part in text.split(",")], ""
+    if sum(np.prod([len(values) for values in spec], dtype=float) for spec in choices) > MAX_PARTS:
+        raise ValueError(f"{text[:40]!r}... names more than {MAX_PARTS:,} residues, ranges or chains")
+    texts = [join.join(terms) for spec in choices for terms in itertools.product(*spec)]
+    parts, carried = [], None
+    for part in texts:
+        named = _read(part)
+        if named is None:
+            return None
+        if named.chain is None and carried is not None:
+            named = replace(named, chain=carried)
+        carried = named.chain
+        parts.append((part, named))
+    return parts if len(parts) > 1 else None
 
 
 def _read(text: str) -> _Named | None:

@@ -79,7 +79,8 @@ class Navigation:
 
     def go_to(self, text: str) -> np.ndarray:
         """Select and centre on the residues named by ``text`` (``A:45``, ``45`` in the edited
-        chain, ``A:40-50``, or as ChimeraX and PyMOL name them: :mod:`core.protein.lookup`);
+        chain, ``A:40-50``, ``A:40-42, B:45``, or as ChimeraX and PyMOL name them:
+        :mod:`core.protein.lookup`);
         returns their residue-table rows (raises ValueError)."""
         if self.document.model is None:
             raise ValueError("no structure is open")

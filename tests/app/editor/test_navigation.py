@@ -134,6 +134,14 @@ def test_go_to_residue_by_keyboard(window: MainWindow, qtbot: QtBot) -> None:
         qtbot.keyClicks(window.navigation.go_to_field, typed)
         qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
         assert list(window.document.selection) == list(range(29, 35)), typed
+    for typed in ("A:30-32, 40", "/A:30-32,40", "resi 30-32+40"):  # lists, in each syntax
+        qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+        qtbot.keyClicks(window.navigation.go_to_field, typed)
+        qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
+        assert list(window.document.selection) == [29, 30, 31, 39], typed
+        np.testing.assert_allclose(_focal(window), np.mean([_ca(window, r) for r in (29, 30, 31, 39)], axis=0),
+                                   atol=1e-6)
+    window.navigation.go_to("30-35")
 
     before = _focal(window)
     qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)

@@ -45,6 +45,21 @@ def test_chimerax_and_pymol_forms(haemoglobin, text: str, chain: str | None, lab
     assert np.array_equal(rows, np.arange(rows[0], rows[-1] + 1))
 
 
+@pytest.mark.parametrize(("text", "chain", "labels"), [
+    ("A:40-42, B:45", None, ["A:LYS40", "A:THR41", "A:TYR42", "B:PHE45"]),
+    ("A:40-42, 50", "C", ["A:LYS40", "A:THR41", "A:TYR42", "A:HIS50"]),  # 50 in the chain before it
+    ("45, 50", "C", ["C:HIS45", "C:HIS50"]),
+    ("/A,B:41,50", None, ["A:THR41", "A:HIS50", "B:PHE41", "B:THR50"]),  # ChimeraX
+    ("/A:40-41 /B:45", None, ["A:LYS40", "A:THR41", "B:PHE45"]), ("#1/C,D:3", None, ["C:SER3", "D:LEU3"]),
+    ("resi 10+12+14", "C", ["C:VAL10", "C:ALA12", "C:TRP14"]),  # PyMOL
+    ("chain A+B and resi 5", None, ["A:ALA5", "B:PRO5"]), ("resi 40-41+50 and c. D", None, ["D:ARG40", "D:PHE41", "D:THR50"]),
+    ("B:45, B:44-46", None, ["B:SER44", "B:PHE45", "B:GLY46"]),  # overlapping parts: each residue once
+])
+def test_lists_of_residues_ranges_and_chains(haemoglobin, text: str, chain: str | None, labels: list[str]) -> None:
+    rows = find_residues(haemoglobin, text, chain)
+    assert [_label(haemoglobin, int(row)) for row in rows] == labels
+
+
 def test_a_range_in_either_order(haemoglobin) -> None:
     rows = find_residues(haemoglobin, "B:40-50")
     assert [_label(haemoglobin, int(r)) for r in rows[[0, -1]]] == ["B:ARG40", "B:THR50"] and len(rows) == 11
@@ -62,7 +77,9 @@ def test_insertion_codes() -> None:
 @pytest.mark.parametrize(("text", "message"), [
     ("A:999", "no residue A:999 in chain A"), ("Z:5", "no chain Z"), ("A:ALA45", "no residue A:ALA45"),
     ("hello world", "cannot read 'hello world'"), ("", "cannot read"),
-    ("resi 45+47", r"cannot read 'resi 45\+47' as residues: type e.g. A:45.*ChimeraX /A:45-50.*PyMOL chain A and resi"),
+    ("resi 45+", r"cannot read 'resi 45\+' as residues: type e.g. A:45.*ChimeraX /A:45-50.*PyMOL chain A and resi"),
+    ("A:40-42, 999", "no residue 999 in chain A"), ("A:40,,", "cannot read"), ("/A,Z:5", "no chain Z"),
+    ("resi " + "+".join(["45"] * 10_001), "names more than 10,000"),
     ("byres all", "cannot read 'byres all'"), ("chain A and chain B", "cannot read"), ("resn LYS", "cannot read"),
     ("#1", "cannot read"), ("/Z:5", "no chain Z"), ("chain B and resi 400", "no residue chain B and resi 400 in chain B"),
 ])
