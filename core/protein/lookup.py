@@ -1,8 +1,8 @@
 """Residues named as people type them: ``A:45``, ``45``, ``A45``, ``A:LYS45``, ``A:52A``,
 ``A:40-50``, lists of these (``A:40-42, B:45, 50``); as ChimeraX specifies them (``/A:45-50``,
-``:45``, ``#1/A:45``, ``/A``, lists ``/A,B:40-42,50 /C:7``); and as PyMOL selects them
-(``chain A and resi 45-50``, ``resi 45``, ``c. A & i. 45``, lists ``chain A+B and resi 40-42+50``,
-``/obj//A/45``, ``A/45/``, ``A/LYS`45/CA``)."""
+``:45``, ``#1/A:45``, ``/A``, ``:his``, lists ``/A,B:40-42,50 /C:7``); and as PyMOL selects them
+(``chain A and resi 45-50``, ``resi 45``, ``c. A & i. 45``, ``resn HIS``, lists
+``chain A+B and resi 40-42+50``, ``/obj//A/45``, ``A/45/``, ``A/LYS`45/CA``)."""
 
 from __future__ import annotations
 
@@ -17,18 +17,19 @@ from core.protein.structure import Structure
 _NUMBERS = r"(?P<first>-?\d+)(?P<icode>[A-Za-z]?)(?:\s*(?:-|–|\.\.)\s*(?P<last>-?\d+)(?P<last_icode>[A-Za-z]?))?"
 _CHAIN = r"[A-Za-z0-9]{1,4}"
 _OWN = re.compile(rf"(?:(?P<chain>{_CHAIN})\s*[:/]\s*|(?P<letter>[A-Za-z])(?=-?\d))?(?P<name>[A-Za-z]{{3}})?{_NUMBERS}")
-_CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{_CHAIN}))?\s*(?::{_NUMBERS})?")
+_CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{_CHAIN}))?\s*(?::(?:{_NUMBERS}|(?P<name>[A-Za-z]{{3}})))?")
 _PYMOL_RESI = re.compile(rf"(?:(?P<name>[A-Za-z]{{3}})`)?{_NUMBERS}")
 _PYMOL_WORDS = {"chain": "chain", "c.": "chain", "resi": "resi", "i.": "resi", "resn": "resn", "r.": "resn"}
-HELP = ("type e.g. A:45, 45, A:40-50 or A:40-42, B:45; ChimeraX /A:45-50,60 or :45; PyMOL chain A and resi "
-        "45-50+60, resi 45, /obj//A/45 or A/45/")
+HELP = ("type e.g. A:45, 45, A:40-50 or A:40-42, B:45; ChimeraX /A:45-50,60, :45 or :his; PyMOL chain A and "
+        "resi 45-50+60, resi 45, resn HIS, /obj//A/45 or A/45/")
 MAX_PARTS = 10_000
 """Most parts (a residue, range or chain each) a list may name."""
 
 
 @dataclass(frozen=True)
 class _Named:
-    """What a text names: a chain, a residue or a range of them, in any of the syntaxes."""
+    """What a text names, in any of the syntaxes: a residue or a range of them, a chain, or the
+    residues of a name (``first`` None and ``name`` given; in ``chain`` or in all)."""
 
     chain: str | None = None
     first: int | None = None
@@ -46,8 +47,8 @@ class _Named:
 
 def find_residues(structure: Structure, text: str, chain: str | None = None) -> np.ndarray:
     """Residue-table rows named by ``text``, in increasing order: one residue (``A:45``, ``45``,
-    ``A45``, ``A:LYS45``, ``A:52A``), a range (``A:40-50``), a whole chain (``/A``, ``chain A``)
-    or a list of them (``A:40-42, B:45``, ``/A:40-42,50``, ``resi 40-42+50``), in any syntax of
+    ``A45``, ``A:LYS45``, ``A:52A``), a range (``A:40-50``), a whole chain (``/A``, ``chain A``),
+    the residues of a name (``resn HIS``, ``:his``: in every chain where none is named) or a list of them (``A:40-42, B:45``, ``/A:40-42,50``, ``resi 40-42+50``), in any syntax of
     the module's; a part names ``chain`` when neither it nor a part before it in its list names
     one (any chain when ``chain`` is None, the first that has it). Raises ValueError naming what
     is missing or how to type it."""
@@ -65,8 +66,15 @@ def _rows(structure: Structure, text: str, named: _Named, chain: str | None) -> 
     if named.chain is not None and named.chain not in chains:
         known = ", ".join(chain or "none (the file names no chain)" for chain in dict.fromkeys(chains))
         raise ValueError(f"no chain {named.chain} with a protein backbone (chains: {known})")
-    if named.first is None:  # a whole chain
-        return np.concatenate([s.residue_index for s in structure.segments if s.chain == named.chain])
+    if named.first is None:  # a whole chain, or the residues of a name (in every chain where none is named)
+        segments = [s for s in structure.segments if named.chain in (None, s.chain)]
+        rows = np.concatenate([s.residue_index for s in segments])
+        if named.name is None:
+            return rows
+        rows = rows[np.concatenate([s.resname for s in segments]) == named.name.upper()]
+        if not len(rows):
+            raise ValueError(f"no residue {named.name.upper()}" + (f" in chain {named.chain}" if named.chain else ""))
+        return rows
     wanted = named.chain if named.chain is not None else chain
     first = _row(structure, wanted, named.first, named.icode, named.name, text)
     if named.last is None:
@@ -157,8 +165,9 @@ def _read(text: str) -> _Named | None:
     """``text`` read in the first syntax that reads it whole, or None."""
     if match := _OWN.fullmatch(text):
         return _Named.of(match, match["chain"] or match["letter"], match["name"])
-    if text.startswith(("/", "#", ":")) and (match := _CHIMERAX.fullmatch(text)) and (match["chain"] or match["first"]):
-        return _Named.of(match, match["chain"])
+    if text.startswith(("/", "#", ":")) and (match := _CHIMERAX.fullmatch(text)) and (
+            match["chain"] or match["first"] or match["name"]):
+        return _Named.of(match, match["chain"], match["name"])
     if "/" in text:
         return _pymol_path(text)
     return _pymol_words(text)
@@ -184,7 +193,7 @@ def _pymol_path(text: str) -> _Named | None:
 
 def _pymol_words(text: str) -> _Named | None:
     """PyMOL's property selectors joined by ``and`` (or ``&``): ``chain A and resi 45-50``,
-    ``c. A & i. 45``, ``resn LYS and resi 45``."""
+    ``c. A & i. 45``, ``resn LYS and resi 45``, ``resn HIS`` (every histidine)."""
     found: dict[str, str] = {}
     for term in re.split(r"\s+and\s+|\s*&\s*", text.strip(), flags=re.IGNORECASE):
         word, _, value = term.strip().partition(" ")
@@ -197,7 +206,7 @@ def _pymol_words(text: str) -> _Named | None:
                                                                    and not re.fullmatch("[A-Za-z]{3}", name)):
         return None
     if "resi" not in found:
-        return _Named(chain) if chain is not None and name is None else None
+        return _Named(chain, name=name) if chain is not None or name is not None else None
     match = re.fullmatch(_NUMBERS, found["resi"])
     return None if match is None else _Named.of(match, chain, name)
 

@@ -60,6 +60,18 @@ def test_lists_of_residues_ranges_and_chains(haemoglobin, text: str, chain: str 
     assert [_label(haemoglobin, int(row)) for row in rows] == labels
 
 
+@pytest.mark.parametrize(("text", "chain", "names", "chains"), [
+    ("resn HIS", None, "HIS", "ABCD"), ("r. his", "A", "HIS", "ABCD"), (":his", "A", "HIS", "ABCD"),
+    ("resn HIS and chain B", None, "HIS", "B"), ("/B:his", None, "HIS", "B"), ("resn HIS+TRP", "C", "HIS TRP", "ABCD"),
+    ("chain A+C and resn TRP", None, "TRP", "AC"),
+])
+def test_the_residues_of_a_name(haemoglobin, text: str, chain: str | None, names: str, chains: str) -> None:
+    rows = find_residues(haemoglobin, text, chain)  # in every chain where the text names none
+    expected = np.concatenate([s.residue_index[np.isin(s.resname, names.split())]
+                               for s in haemoglobin.segments if s.chain in chains])
+    assert len(rows) >= 2 and np.array_equal(rows, np.sort(expected))
+
+
 def test_a_range_in_either_order(haemoglobin) -> None:
     rows = find_residues(haemoglobin, "B:40-50")
     assert [_label(haemoglobin, int(r)) for r in rows[[0, -1]]] == ["B:ARG40", "B:THR50"] and len(rows) == 11
@@ -80,7 +92,8 @@ def test_insertion_codes() -> None:
     ("resi 45+", r"cannot read 'resi 45\+' as residues: type e.g. A:45.*ChimeraX /A:45-50.*PyMOL chain A and resi"),
     ("A:40-42, 999", "no residue 999 in chain A"), ("A:40,,", "cannot read"), ("/A,Z:5", "no chain Z"),
     ("resi " + "+".join(["45"] * 10_001), "names more than 10,000"),
-    ("byres all", "cannot read 'byres all'"), ("chain A and chain B", "cannot read"), ("resn LYS", "cannot read"),
+    ("byres all", "cannot read 'byres all'"), ("chain A and chain B", "cannot read"), ("resn XYZ", "no residue XYZ"),
+    ("chain A and resn ILE", "no residue ILE in chain A"),
     ("#1", "cannot read"), ("/Z:5", "no chain Z"), ("chain B and resi 400", "no residue chain B and resi 400 in chain B"),
 ])
 def test_clear_messages(haemoglobin, text: str, message: str) -> None:
