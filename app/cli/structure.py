@@ -64,8 +64,8 @@ def info_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def summary(structure: Structure) -> dict:
-    """Chains (with their nucleotides), segments, residues, secondary structure and maximum
-    levels of a structure."""
+    """Chains (with their nucleotides), ligands and ions, segments, residues, secondary
+    structure and maximum levels of a structure."""
     segments = []
     for number, segment in enumerate(structure.segments):
         segments.append({
@@ -94,6 +94,7 @@ def summary(structure: Structure) -> dict:
              "nucleotides": c.n_nucleotides, "nucleic_acid": c.nucleic_acid}
             for c in structure.chains
         ],
+        "ligands": [{"name": name, "count": count} for name, count in _ligands(structure).items()],
         "segments": segments,
         "residues": structure.n_residues,
         "secondary_structure": {"H": ss["H"], "E": ss["E"], "C": ss["C"]},
@@ -112,6 +113,8 @@ def run_info(args: argparse.Namespace) -> int:
     print(f"  {report['atoms']} atoms ({report['hetero_atoms']} hetero, {report['water_atoms']} water, "
           f"{report['altloc_atoms']} with altlocs); "
           + (f"model {report['model']} of {report['models']}" if report["models"] > 1 else "1 model"))
+    if report["ligands"]:
+        print("  ligands and ions: " + ", ".join(f"{ligand['name']} ({ligand['count']})" for ligand in report["ligands"]))
     nucleic = [c for c in report["chains"] if c["nucleotides"]]
     if nucleic:
         print("  nucleic acids: " + ", ".join(f"chain {c['chain']} {c['nucleotides']} nucleotides"
@@ -130,6 +133,14 @@ def run_info(args: argparse.Namespace) -> int:
 
 
 # ------------------------------------------------------------------------------ helpers
+
+
+def _ligands(structure: Structure) -> dict[str, int]:
+    """How many groups of each name the ligands and ions are (no waters, no polymer), in file order."""
+    atoms = structure.atoms
+    ligand = np.flatnonzero(atoms.category == "ligand")
+    _, first = np.unique(atoms.residue[ligand], return_index=True)
+    return dict(Counter(atoms.resname[ligand[np.sort(first)]].tolist()))
 
 
 def segment_number(structure: Structure, number: int) -> int:

@@ -47,6 +47,15 @@ def test_info_text_lists_every_segment_of_a_broken_chain(capsys):
         assert segment.labels[0] in out and segment.labels[-1] in out
 
 
+def test_info_counts_the_ligands_and_ions_by_name(capsys):
+    status, out, _ = run(capsys, "info", DATA / "4HHB.pdb.gz", "--json")
+    assert status == 0 and json.loads(out)["ligands"] == [{"name": "HEM", "count": 4}, {"name": "PO4", "count": 2}]
+    status, out, _ = run(capsys, "info", DATA / "3PTB.pdb.gz")  # trypsin's calcium and benzamidine
+    assert status == 0 and "ligands and ions: CA (1), BEN (1)" in out
+    status, out, _ = run(capsys, "info", DATA / "1UBQ.pdb.gz", "--json")  # waters only
+    assert status == 0 and json.loads(out)["ligands"] == []
+
+
 def test_info_names_the_nucleic_acids_and_describes_an_entry_without_protein(capsys):
     status, out, _ = run(capsys, "info", DATA / "1BNA.pdb.gz")  # the Dickerson dodecamer: DNA only
     assert status == 0
