@@ -216,8 +216,8 @@ def _junction_flags(
         ca_ca = distance(ca1, ca2)
         cis = np.where(np.isnan(omega), ca_ca < 0.5 * (CA_CA_CIS + CA_CA_TRANS), np.abs(omega) < 90)
         measures = {
-            "peptide_bond": (distance(c1, n2), np.where(proline, C_N_PRO, C_N), PEPTIDE_BOND_TOLERANCE, "Å"),
-            "ca_ca": (ca_ca, np.where(cis, CA_CA_CIS, CA_CA_TRANS), np.where(cis, CA_CA_CIS_TOLERANCE, CA_CA_TOLERANCE), "Å"),
+            "peptide_bond": (distance(c1, n2), np.where(proline, C_N_PRO, C_N), PEPTIDE_BOND_TOLERANCE, " Å"),
+            "ca_ca": (ca_ca, np.where(cis, CA_CA_CIS, CA_CA_TRANS), np.where(cis, CA_CA_CIS_TOLERANCE, CA_CA_TOLERANCE), " Å"),
             "angle_ca_c_n": (angle(ca1, c1, n2), np.where(proline, CA_C_N_PRO, CA_C_N),
                              ANGLE_SIGMAS * np.where(proline, 1.5, 2.0), "°"),
             "angle_c_n_ca": (angle(c1, n2, ca2), np.where(proline, C_N_CA_PRO, C_N_CA),
