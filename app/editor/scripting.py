@@ -116,7 +116,8 @@ class EditorAPI:
 
     def go_to(self, residues: str) -> list[str]:
         """Select ``residues`` (``'A:45'``, ``'45'`` in the edited chain, ``'A:40-50'``, ``'A:40-42, B:45'``;
-        ChimeraX's ``'/A:40-50'``, PyMOL's ``'chain A and resi 40-50+60'``: :mod:`core.protein.lookup`) and
+        ChimeraX's ``'/A:40-50'``, PyMOL's ``'chain A and resi 40-50+60'``, a binding site
+        ``'byres resn HEM around 5'``: :mod:`core.protein.lookup`) and
         centre the view on them, as Go to Residue (Ctrl+L) does; their chain becomes the edited
         segment. Returns their labels (ValueError for a residue that does not exist)."""
         document = self._document

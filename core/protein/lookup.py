@@ -2,7 +2,9 @@
 ``A:40-50``, lists of these (``A:40-42, B:45, 50``); as ChimeraX specifies them (``/A:45-50``,
 ``:45``, ``#1/A:45``, ``/A``, ``:his``, lists ``/A,B:40-42,50 /C:7``); and as PyMOL selects them
 (``chain A and resi 45-50``, ``resi 45``, ``c. A & i. 45``, ``resn HIS``, lists
-``chain A+B and resi 40-42+50``, ``/obj//A/45``, ``A/45/``, ``A/LYS`45/CA``)."""
+``chain A+B and resi 40-42+50``, ``/obj//A/45``, ``A/45/``, ``A/LYS`45/CA``); and the residues
+near others or a ligand, as both select a binding site (``byres resn HEM around 5``,
+``within 5 of A:45``; ``:HEM :<5``)."""
 
 from __future__ import annotations
 
@@ -11,19 +13,30 @@ import re
 from dataclasses import dataclass, replace
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from core.protein.structure import Structure
 
 _NUMBERS = r"(?P<first>-?\d+)(?P<icode>[A-Za-z]?)(?:\s*(?:-|–|\.\.)\s*(?P<last>-?\d+)(?P<last_icode>[A-Za-z]?))?"
 _CHAIN = r"[A-Za-z0-9]{1,4}"
 _OWN = re.compile(rf"(?:(?P<chain>{_CHAIN})\s*[:/]\s*|(?P<letter>[A-Za-z])(?=-?\d))?(?P<name>[A-Za-z]{{3}})?{_NUMBERS}")
-_CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{_CHAIN}))?\s*(?::(?:{_NUMBERS}|(?P<name>[A-Za-z]{{3}})))?")
+_NAME = r"(?=[A-Za-z0-9]*[A-Za-z])[A-Za-z0-9]{1,5}"
+"""A residue or ligand name (HIS, PO4, 5CM, A): letters and digits, at least one letter."""
+_CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{_CHAIN}))?\s*(?::(?:{_NUMBERS}|(?P<name>{_NAME})))?")
 _PYMOL_RESI = re.compile(rf"(?:(?P<name>[A-Za-z]{{3}})`)?{_NUMBERS}")
 _PYMOL_WORDS = {"chain": "chain", "c.": "chain", "resi": "resi", "i.": "resi", "resn": "resn", "r.": "resn"}
-HELP = ("type e.g. A:45, 45, A:40-50 or A:40-42, B:45; ChimeraX /A:45-50,60, :45 or :his; PyMOL chain A and "
-        "resi 45-50+60, resi 45, resn HIS, /obj//A/45 or A/45/")
+HELP = ("type e.g. A:45, 45, A:40-50 or A:40-42, B:45; ChimeraX /A:45-50,60, :45, :his or :HEM :<5; PyMOL "
+        "chain A and resi 45-50+60, resi 45, resn HIS, byres resn HEM around 5, /obj//A/45 or A/45/")
 MAX_PARTS = 10_000
 """Most parts (a residue, range or chain each) a list may name."""
+MAX_REACH = 50.0
+"""Å: the farthest a selection of the residues near others reaches."""
+_NUMBER = r"(?P<reach>\d+(?:\.\d*)?|\.\d+)"
+_NEAR = (re.compile(rf"(?:byres\s+)?\(?(?P<of>.+?)\)?\s+(?P<how>around|expand)\s+{_NUMBER}", re.IGNORECASE),  # PyMOL
+         re.compile(rf"(?:byres\s+)?within\s+{_NUMBER}\s+of\s+\(?(?P<of>.+?)\)?", re.IGNORECASE),
+         re.compile(rf"(?P<of>.+?)\s+[:@]<\s*{_NUMBER}"))  # ChimeraX's zone
+"""The residues near others: PyMOL's ``around`` (without them) and ``expand`` and ``within``
+(with them, where they are residues of the backbone), ChimeraX's zone (with them)."""
 
 
 @dataclass(frozen=True)
@@ -45,19 +58,52 @@ class _Named:
                    None if last is None else int(last), (match["last_icode"] or "").upper(), name)
 
 
-def find_residues(structure: Structure, text: str, chain: str | None = None) -> np.ndarray:
+def find_residues(structure: Structure, text: str, chain: str | None = None, coords: np.ndarray | None = None
+                  ) -> np.ndarray:
     """Residue-table rows named by ``text``, in increasing order: one residue (``A:45``, ``45``,
     ``A45``, ``A:LYS45``, ``A:52A``), a range (``A:40-50``), a whole chain (``/A``, ``chain A``),
     the residues of a name (``resn HIS``, ``:his``: in every chain where none is named) or a list of them (``A:40-42, B:45``, ``/A:40-42,50``, ``resi 40-42+50``), in any syntax of
     the module's; a part names ``chain`` when neither it nor a part before it in its list names
-    one (any chain when ``chain`` is None, the first that has it). Raises ValueError naming what
-    is missing or how to type it."""
+    one (any chain when ``chain`` is None, the first that has it). Or the residues with an atom
+    within a distance of those or of a ligand's (``byres resn HEM around 5``), measured on
+    ``coords`` (every atom's, Å; default: as read). Raises ValueError naming what is missing or
+    how to type it."""
+    for pattern in _NEAR:
+        if near := pattern.fullmatch(text.strip()):
+            return _near(structure, near, chain, structure.coords if coords is None else coords)
     parts = _read_all(text.strip())
     if parts is None:
         raise ValueError(f"cannot read {text.strip()!r} as residues: {HELP}")
     if len(parts) == 1:
         return _rows(structure, *parts[0], chain)
     return np.unique(np.concatenate([_rows(structure, part, named, chain) for part, named in parts]))
+
+
+def _near(structure: Structure, near: re.Match, chain: str | None, coords: np.ndarray) -> np.ndarray:
+    """The backbone residues with an atom within ``near``'s reach of the atoms it names: of a
+    residue name (a ligand's: ``resn HEM``, ``:HEM``, in a chain too) or of residues."""
+    reach = float(near["reach"])
+    if not 0.0 < reach <= MAX_REACH:
+        raise ValueError(f"a distance of {near['reach']} Å: give one above 0 and at most {MAX_REACH:g} Å")
+    atoms, of = structure.atoms, near["of"].strip()
+    named = _read(of)
+    if named is not None and named.first is None and named.name is not None:  # every group of a name
+        chosen = (atoms.resname == named.name.upper()) & ((atoms.chain == named.chain) if named.chain else True)
+        if not chosen.any():
+            raise ValueError(f"no residue or ligand {named.name.upper()}"
+                             + (f" in chain {named.chain}" if named.chain else ""))
+        rows = np.unique(structure.atom_residue[chosen & (structure.atom_residue >= 0)])
+    else:
+        rows = find_residues(structure, of, chain)
+        chosen = np.isin(structure.atom_residue, rows)
+    backbone = np.flatnonzero(structure.atom_residue >= 0)
+    close = cKDTree(coords[chosen]).query_ball_point(coords[backbone], reach, return_length=True) > 0
+    found = np.unique(structure.atom_residue[backbone[close]])
+    if (near.groupdict().get("how") or "").lower() == "around":
+        found = np.setdiff1d(found, rows)
+    if not len(found):
+        raise ValueError(f"no residue within {reach:g} Å of {of}")
+    return found
 
 
 def _rows(structure: Structure, text: str, named: _Named, chain: str | None) -> np.ndarray:
@@ -203,7 +249,7 @@ def _pymol_words(text: str) -> _Named | None:
         found[key] = value.strip()
     chain, name = found.get("chain"), found.get("resn")
     if (chain is not None and not re.fullmatch(_CHAIN, chain)) or (name is not None
-                                                                   and not re.fullmatch("[A-Za-z]{3}", name)):
+                                                                   and not re.fullmatch(_NAME, name)):
         return None
     if "resi" not in found:
         return _Named(chain, name=name) if chain is not None or name is not None else None

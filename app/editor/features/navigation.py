@@ -79,13 +79,13 @@ class Navigation:
 
     def go_to(self, text: str) -> np.ndarray:
         """Select and centre on the residues named by ``text`` (``A:45``, ``45`` in the edited
-        chain, ``A:40-50``, ``A:40-42, B:45``, or as ChimeraX and PyMOL name them:
-        :mod:`core.protein.lookup`);
+        chain, ``A:40-50``, ``A:40-42, B:45``, or as ChimeraX and PyMOL name them, a binding site
+        too, measured as the atoms are now: :mod:`core.protein.lookup`);
         returns their residue-table rows (raises ValueError)."""
         if self.document.model is None:
             raise ValueError("no structure is open")
         chain = self.document.structure.segments[self.document.segment].chain
-        rows = find_residues(self.document.structure, text, chain)
+        rows = find_residues(self.document.structure, text, chain, self.document.model.coords)
         self.select_and_centre(rows)
         return rows
 

@@ -162,6 +162,26 @@ def test_go_to_another_chain_makes_it_the_edited_segment(open_window: Opener) ->
     np.testing.assert_allclose(_focal(window), _ca(window, int(rows[0])), atol=1e-6)
 
 
+def test_go_to_a_binding_site_measures_the_atoms_where_they_are_now(open_window: Opener, qtbot: QtBot) -> None:
+    window = open_window("4HHB.pdb.gz")
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow)
+    field, document = window.navigation.go_to_field, window.document
+    qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+    qtbot.keyClicks(field, "byres resn HEM and chain A around 4")  # as a PyMOL user types it
+    qtbot.keyClick(field, Qt.Key.Key_Return)
+    pocket = [document.structure.residue_label(int(row)) for row in document.selection]
+    assert len(pocket) == 16 and "A:HIS87" in pocket and all(label.startswith("A:") for label in pocket)
+    np.testing.assert_allclose(_focal(window), np.mean([_ca(window, r) for r in document.selection], axis=0), atol=1e-6)
+    window.rw.level = document.max_level
+    document.set_carry_ligands(False)  # the haem stays where it is
+    window.rw.tug("A:HIS87", [0.0, 0.0, 12.0])  # the proximal histidine pulled out of the pocket
+    qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+    qtbot.keyClicks(field, ":HEM :<4")
+    qtbot.keyClick(field, Qt.Key.Key_Return)
+    assert "A:HIS87" not in [document.structure.residue_label(int(row)) for row in document.selection]
+
+
 def test_double_click_centres_on_what_is_under_the_pointer(window: MainWindow, qtbot: QtBot) -> None:
     window.scene.set_layer(Layer.CONTROL_POINTS, False)
     row = _front_residue(window, np.arange(40, 60))

@@ -72,6 +72,41 @@ def test_the_residues_of_a_name(haemoglobin, text: str, chain: str | None, names
     assert len(rows) >= 2 and np.array_equal(rows, np.sort(expected))
 
 
+def _within(structure, reference: np.ndarray, reach: float, coords: np.ndarray) -> np.ndarray:
+    """Brute force: the backbone residues with an atom within ``reach`` of an atom of ``reference``."""
+    backbone = np.flatnonzero(structure.atom_residue >= 0)
+    distance = np.linalg.norm(coords[backbone][:, None] - coords[reference][None], axis=2).min(axis=1)
+    return np.unique(structure.atom_residue[backbone[distance <= reach]])
+
+
+@pytest.mark.parametrize("text", ["byres resn HEM around 5", "resn HEM expand 5", "within 5 of resn HEM", ":HEM :<5",
+                                  ":hem @< 5.0", "byres (r. hem) around 5"])
+def test_a_binding_site_in_each_syntax(haemoglobin, text: str) -> None:
+    rows = find_residues(haemoglobin, text)
+    expected = _within(haemoglobin, np.flatnonzero(haemoglobin.atoms.resname == "HEM"), 5.0, haemoglobin.coords)
+    assert len(rows) > 40 and np.array_equal(rows, expected)  # each haem's pocket, in all four chains
+
+
+def test_around_leaves_out_the_residues_it_is_around_and_expand_keeps_them(haemoglobin) -> None:
+    his87 = find_residues(haemoglobin, "A:87")
+    around, expand = find_residues(haemoglobin, "A:87 around 6"), find_residues(haemoglobin, "A:87 expand 6")
+    assert his87[0] not in around and np.array_equal(expand, np.union1d(around, his87))
+    assert np.array_equal(expand, _within(haemoglobin, np.flatnonzero(haemoglobin.atom_residue == his87[0]), 6.0,
+                                          haemoglobin.coords))
+    in_a = find_residues(haemoglobin, "resn HEM and chain A around 4")
+    assert np.array_equal(in_a, find_residues(haemoglobin, "/A:HEM :<4")) and "A:HIS87" in [
+        haemoglobin.residue_label(int(row)) for row in in_a]  # the proximal histidine
+
+
+def test_a_binding_site_is_measured_on_the_coordinates_given(haemoglobin) -> None:
+    moved = haemoglobin.coords.copy()
+    haem_a = (haemoglobin.atoms.resname == "HEM") & (haemoglobin.atoms.chain == "A")
+    moved[haem_a] += 200.0  # far from every chain
+    assert len(find_residues(haemoglobin, "resn HEM and chain A around 4")) == 16
+    with pytest.raises(ValueError, match="no residue within 4 Å of resn HEM and chain A"):
+        find_residues(haemoglobin, "resn HEM and chain A around 4", coords=moved)
+
+
 def test_a_range_in_either_order(haemoglobin) -> None:
     rows = find_residues(haemoglobin, "B:40-50")
     assert [_label(haemoglobin, int(r)) for r in rows[[0, -1]]] == ["B:ARG40", "B:THR50"] and len(rows) == 11
@@ -92,6 +127,8 @@ def test_insertion_codes() -> None:
     ("resi 45+", r"cannot read 'resi 45\+' as residues: type e.g. A:45.*ChimeraX /A:45-50.*PyMOL chain A and resi"),
     ("A:40-42, 999", "no residue 999 in chain A"), ("A:40,,", "cannot read"), ("/A,Z:5", "no chain Z"),
     ("resi " + "+".join(["45"] * 10_001), "names more than 10,000"),
+    ("A:87 around 99", "a distance of 99 Å: give one above 0 and at most 50 Å"), ("resn XYZ around 5", "no residue or ligand XYZ"),
+    ("resn HEM and chain Q around 5", "no residue or ligand HEM in chain Q"), ("A:999 around 5", "no residue A:999"),
     ("byres all", "cannot read 'byres all'"), ("chain A and chain B", "cannot read"), ("resn XYZ", "no residue XYZ"),
     ("chain A and resn ILE", "no residue ILE in chain A"),
     ("#1", "cannot read"), ("/Z:5", "no chain Z"), ("chain B and resi 400", "no residue chain B and resi 400 in chain B"),
