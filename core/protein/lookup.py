@@ -136,18 +136,62 @@ def _rows(structure: Structure, text: str, named: _Named, chain: str | None) -> 
 def find_atom(structure: Structure, text: str, chain: str | None = None) -> int:
     """Coordinate row of the atom named by ``text``: one residue as :func:`find_residues` reads
     it and an atom name, ``A:LYS48 NZ``, ``48 CA`` (in ``chain``), ``/A:48@NZ`` (ChimeraX),
-    ``A/48/NZ`` or ``chain A and resi 48 and name NZ`` (PyMOL); the first alternate location.
+    ``A/48/NZ`` or ``chain A and resi 48 and name NZ`` (PyMOL); or of a group outside the
+    protein's backbone, a ligand, ion, water or nucleotide, by its number or name
+    (``A:HEM FE``, ``/A:HEM@FE``, ``A:142 FE``, ``/B:DA5@P``); the first alternate location.
     Raises ValueError naming what is missing or how to type it."""
     residue, name = _atom_parts(text.strip())
     if not name:
         raise ValueError(f"cannot read {text.strip()!r} as an atom: type e.g. A:48 NZ, /A:48@NZ or A/48/NZ")
-    rows = find_residues(structure, residue, chain)
+    try:
+        rows = find_residues(structure, residue, chain)
+    except ValueError:
+        row = _group_atom(structure, residue.strip(), name.upper(), chain)
+        if row is None:
+            raise
+        return row
     if len(rows) != 1:
         raise ValueError(f"{text.strip()!r} names {len(rows)} residues: name one, and an atom of it")
     atoms = np.flatnonzero((structure.atom_residue == rows[0]) & (structure.atoms.name == name.upper()))
     if not len(atoms):
         raise ValueError(f"no atom {name.upper()} in {_label(structure, int(rows[0]))}")
     return int(atoms[0])
+
+
+def _group_atom(structure: Structure, text: str, name: str, chain: str | None) -> int | None:
+    """Coordinate row of atom ``name`` of the one group outside the backbone segments (a ligand,
+    ion, water or nucleotide) named by ``text`` (its number, name or both, as residues are
+    named, or ``A:HEM``), in ``chain`` when the text names none and that chain has it; None
+    where the text names none such. ValueError where it names several, or one without the atom."""
+    named, own = _read(text), False
+    if named is None and (match := re.fullmatch(rf"(?P<chain>{_CHAIN})\s*:\s*(?P<name>{_NAME})", text)):
+        named, own = _Named(match["chain"], name=match["name"]), True
+    if named is None or named.last is not None or (named.first is None and named.name is None):
+        return None
+    atoms = structure.atoms
+    chosen = structure.atom_residue < 0
+    if named.first is not None:
+        chosen &= atoms.resseq == named.first
+    if named.name is not None:
+        chosen &= atoms.resname == named.name.upper()
+    where = named.chain if named.chain is not None else chain
+    if where is not None and (named.chain is not None or (chosen & (atoms.chain == where)).any()):
+        chosen &= atoms.chain == where
+    rows = np.flatnonzero(chosen)
+    if not len(rows):
+        if own:
+            raise ValueError(f"no residue or group {named.name.upper()} in chain {named.chain}")
+        return None
+    with_atom = rows[atoms.name[rows] == name]
+    shown = with_atom if len(with_atom) else rows
+    _, first = np.unique(atoms.residue[shown], return_index=True)
+    groups = [f"{atoms.chain[row]}:{atoms.resname[row]}{atoms.resseq[row]}" for row in shown[np.sort(first)].tolist()]
+    if len(groups) > 1:
+        raise ValueError(f"{text!r} names {len(groups)} groups ({', '.join(groups[:6])}"
+                         + (", ..." if len(groups) > 6 else "") + f"): name one, and an atom {name} of it")
+    if not len(with_atom):
+        raise ValueError(f"no atom {name} in {groups[0]}")
+    return int(with_atom[0])
 
 
 def _atom_parts(text: str) -> tuple[str, str]:

@@ -103,6 +103,13 @@ def test_labels_angles_and_dihedrals_from_rw_are_gemmis_and_come_back_with_the_s
         rw.measure("A:45 XX", "A:45 CA")
     with pytest.raises(ValueError, match="1 to 4 different atoms"):
         rw.measure("A:45 CA", "A:45 CA")
+    iron = rw.measure("/A:HEM@FE", "A:87 NE2")  # a ligand's atom, typed as ChimeraX users do
+    assert 1.9 < iron < 2.4 and rw.measurements[-1] == f"A:HEM142 FE – A:HIS87 NE2: {iron:.2f} Å"
+    rw.measure("A:HEM142 FE")  # and labelled
+    assert rw.measurements[-1] == "A:HEM142 FE"
+    for _ in range(2):
+        window.measurements_panel.table.selectRow(len(rw.measurements) - 1)
+        window.measurements_panel.delete.click()
     saved = window.sessions.write_session(tmp_path / "measured")
     window.measurements_panel.table.selectRow(0)
     window.measurements_panel.delete.click()

@@ -162,6 +162,27 @@ def test_atoms_that_are_not_there_are_said_so(haemoglobin, text: str, message: s
         find_atom(haemoglobin, text)
 
 
+@pytest.mark.parametrize(("text", "chain"), [("/A:HEM@FE", None), ("A:HEM FE", None), ("A:HEM142 FE", None),
+                                             ("A:142 FE", None), ("A/HEM`142/FE", None), ("resn HEM and name FE", "A"),
+                                             ("/A:142@FE", "C")])
+def test_an_atom_of_a_ligand_in_each_syntax(haemoglobin, text: str, chain: str | None) -> None:
+    row = find_atom(haemoglobin, text, chain)
+    atoms = haemoglobin.atoms
+    assert (atoms.chain[row], atoms.resname[row], atoms.resseq[row], atoms.name[row]) == ("A", "HEM", 142, "FE")
+    ne2 = find_atom(haemoglobin, "A:87 NE2")  # the proximal histidine binds the iron
+    assert 1.9 < np.linalg.norm(haemoglobin.coords[row] - haemoglobin.coords[ne2]) < 2.4
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("resn HEM and name FE", r"names 4 groups \(A:HEM142, B:HEM148, C:HEM142, D:HEM148\): name one"),
+    ("A:HEM XX", "no atom XX in A:HEM142"), ("A:PO4 P", "no residue or group PO4 in chain A"),
+    ("/A:HOH@O", "names 56 groups"),
+])
+def test_a_ligand_atom_not_named_once_is_said_so(haemoglobin, text: str, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        find_atom(haemoglobin, text)
+
+
 def test_a_file_that_names_no_chain_says_so() -> None:
     adk = read_structure(DATA / "1AKE_adk_closed.pdb.gz")  # chain column blank
     with pytest.raises(ValueError, match=r"no chain A with a protein backbone \(chains: none \(the file names no"):
