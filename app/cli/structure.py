@@ -83,6 +83,8 @@ def summary(structure: Structure) -> dict:
         "format": structure.source_format,
         "entry": structure.entry_id,
         "title": structure.title,
+        "method": structure.method,
+        "resolution": structure.resolution,
         "models": structure.n_models,
         "model": structure.model_number,
         "atoms": structure.n_atoms,
@@ -110,6 +112,9 @@ def run_info(args: argparse.Namespace) -> int:
         return 0
     ss = report["secondary_structure"]
     print(f"{report['file']}: {report['entry']} ({report['format']}), {report['title'] or 'no title'}")
+    if report["method"] or report["resolution"]:
+        print("  " + ", ".join(filter(None, [report["method"], report["resolution"] and
+                                             f"{report['resolution']:g} Å resolution"])))
     print(f"  {report['atoms']} atoms ({report['hetero_atoms']} hetero, {report['water_atoms']} water, "
           f"{report['altloc_atoms']} with altlocs); "
           + (f"model {report['model']} of {report['models']}" if report["models"] > 1 else "1 model"))

@@ -70,6 +70,8 @@ def read_structure(
         source_format=fmt,
         entry_id=st.name,
         title=info(st, "_struct.title"),
+        method="; ".join(dict.fromkeys(experiment.method for experiment in st.meta.experiments if experiment.method)),
+        resolution=float(st.resolution) if st.resolution > 0 else None,
         coords=frozen(atoms.coords),
         atom_residue=frozen(atom_residue(len(atoms.coords), groups, rows)),
         segments=segments,

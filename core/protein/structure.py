@@ -199,6 +199,11 @@ class Structure:
         'pdb' or 'mmcif'.
     entry_id, title : str
         PDB id (or the file name) and title ('' if none).
+    method : str
+        How it was determined, as the file says (``'X-RAY DIFFRACTION'``, ``'SOLUTION NMR'``,
+        ``'ELECTRON MICROSCOPY'``, several joined by ``'; '``; '' if it says not).
+    resolution : float or None
+        Å, as the file gives it (None where it gives none, as for NMR).
     coords : (n_atoms, 3) float64, Å
         Every atom of the model in traversal order.
     atom_residue : (n_atoms,) int64
@@ -225,6 +230,8 @@ class Structure:
     source_format: str
     entry_id: str
     title: str
+    method: str
+    resolution: float | None
     coords: NDArray[np.float64]
     atom_residue: NDArray[np.int64]
     segments: tuple[BackboneSegment, ...]

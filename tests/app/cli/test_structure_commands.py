@@ -34,6 +34,7 @@ def test_info_json_describes_ubiquitin(capsys):
     assert sum(report["secondary_structure"].values()) == 76
     assert report["secondary_structure"]["H"] > 10 and report["secondary_structure"]["E"] > 10
     assert report["secondary_structure_source"] == "HELIX/SHEET records"
+    assert (report["method"], report["resolution"]) == ("X-RAY DIFFRACTION", 1.8)
     (segment,) = report["segments"]
     assert segment["max_level_peptide"] == pytest.approx(math.log2(76), abs=1e-4)
 
@@ -45,6 +46,15 @@ def test_info_text_lists_every_segment_of_a_broken_chain(capsys):
     assert len(structure.segments) > 1
     for segment in structure.segments:
         assert segment.labels[0] in out and segment.labels[-1] in out
+
+
+def test_info_says_how_the_structure_was_determined(capsys):
+    status, out, _ = run(capsys, "info", DATA / "4HHB.pdb.gz")
+    assert status == 0 and out.splitlines()[1] == "  X-RAY DIFFRACTION, 1.74 Å resolution"
+    status, out, _ = run(capsys, "info", DATA / "1LCD.cif.gz", "--json")  # NMR: no resolution
+    assert status == 0 and (json.loads(out)["method"], json.loads(out)["resolution"]) == ("SOLUTION NMR", None)
+    status, out, _ = run(capsys, "info", DATA / "2K39_CA-only.pdb.gz")  # a file that says neither
+    assert status == 0 and out.splitlines()[1].startswith("  76 atoms")
 
 
 def test_info_counts_the_ligands_and_ions_by_name(capsys):
