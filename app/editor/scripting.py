@@ -16,7 +16,7 @@ import numpy as np
 
 from app.editor.features.export import export_view
 from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
-from core.protein.lookup import find_atom, find_residues
+from core.protein.lookup import find_atom, find_group, find_residues
 
 if TYPE_CHECKING:
     from app.editor.docks.panels import DisplayPanel
@@ -124,11 +124,11 @@ class EditorAPI:
         return [document.structure.residue_label(int(row)) for row in self._editor.navigation.go_to(residues)]
 
     def measure(self, *atoms: int | str) -> float | None:
-        """Label one atom (or, named without an atom, ``'A:48'``, its residue), or measure the
-        distance of two, the angle of three or the dihedral of four, as View ▸ Label and the
-        Measure tools do: atoms as coordinate rows or as people name them (``'A:48 NZ'``,
-        ``'/A:48@NZ'``, ``'A/48/NZ'``; in the edited chain where none is named). Returns the
-        value (Å or degrees; None for a label)."""
+        """Label one atom (or, named without an atom, ``'A:48'``, its residue; ``'A:HEM'``, a
+        ligand), or measure the distance of two, the angle of three or the dihedral of four, as
+        View ▸ Label and the Measure tools do: atoms as coordinate rows or as people name them
+        (``'A:48 NZ'``, ``'/A:48@NZ'``, ``'A/48/NZ'``, ``'/A:HEM@FE'``; in the edited chain where
+        none is named). Returns the value (Å or degrees; None for a label)."""
         document = self._document
         chain = document.structure.segments[document.segment].chain if document.editable else None
         if len(atoms) == 1 and isinstance(atoms[0], str) and document.editable:
@@ -138,6 +138,10 @@ class EditorAPI:
                 rows = []
             if len(rows) == 1:  # a residue: its label
                 document.measurements.add([int(document.ca_rows[rows[0]])], len(document.model.coords), True)
+                return None
+            group = None if len(rows) else find_group(document.structure, atoms[0], chain)
+            if group is not None:  # a ligand, ion, water or nucleotide: its label, on its first atom
+                document.measurements.add([int(group[0])], len(document.model.coords), True)
                 return None
         rows = [int(atom) if isinstance(atom, (int, np.integer)) else find_atom(document.structure, atom, chain)
                 for atom in atoms]

@@ -146,10 +146,13 @@ def find_atom(structure: Structure, text: str, chain: str | None = None) -> int:
     try:
         rows = find_residues(structure, residue, chain)
     except ValueError:
-        row = _group_atom(structure, residue.strip(), name.upper(), chain)
-        if row is None:
+        group = find_group(structure, residue, chain)
+        if group is None:
             raise
-        return row
+        atoms = group[structure.atoms.name[group] == name.upper()]
+        if not len(atoms):
+            raise ValueError(f"no atom {name.upper()} in {_group_label(structure, int(group[0]))}") from None
+        return int(atoms[0])
     if len(rows) != 1:
         raise ValueError(f"{text.strip()!r} names {len(rows)} residues: name one, and an atom of it")
     atoms = np.flatnonzero((structure.atom_residue == rows[0]) & (structure.atoms.name == name.upper()))
@@ -158,13 +161,14 @@ def find_atom(structure: Structure, text: str, chain: str | None = None) -> int:
     return int(atoms[0])
 
 
-def _group_atom(structure: Structure, text: str, name: str, chain: str | None) -> int | None:
-    """Coordinate row of atom ``name`` of the one group outside the backbone segments (a ligand,
-    ion, water or nucleotide) named by ``text`` (its number, name or both, as residues are
-    named, or ``A:HEM``), in ``chain`` when the text names none and that chain has it; None
-    where the text names none such. ValueError where it names several, or one without the atom."""
-    named, own = _read(text), False
-    if named is None and (match := re.fullmatch(rf"(?P<chain>{_CHAIN})\s*:\s*(?P<name>{_NAME})", text)):
+def find_group(structure: Structure, text: str, chain: str | None = None) -> np.ndarray | None:
+    """Coordinate rows of the one group outside the backbone segments (a ligand, ion, water or
+    nucleotide) named by ``text``: by its number, name or both, as residues are named
+    (``A:142``, ``A:HEM142``, ``/A:HEM``, ``resn HEM``) or ``A:HEM``, in ``chain`` when the
+    text names none and that chain has it. None where the text names no such group;
+    ValueError where it names several."""
+    named, own = _read(text.strip()), False
+    if named is None and (match := re.fullmatch(rf"(?P<chain>{_CHAIN})\s*:\s*(?P<name>{_NAME})", text.strip())):
         named, own = _Named(match["chain"], name=match["name"]), True
     if named is None or named.last is not None or (named.first is None and named.name is None):
         return None
@@ -182,16 +186,18 @@ def _group_atom(structure: Structure, text: str, name: str, chain: str | None) -
         if own:
             raise ValueError(f"no residue or group {named.name.upper()} in chain {named.chain}")
         return None
-    with_atom = rows[atoms.name[rows] == name]
-    shown = with_atom if len(with_atom) else rows
-    _, first = np.unique(atoms.residue[shown], return_index=True)
-    groups = [f"{atoms.chain[row]}:{atoms.resname[row]}{atoms.resseq[row]}" for row in shown[np.sort(first)].tolist()]
+    groups, first = np.unique(atoms.residue[rows], return_index=True)
     if len(groups) > 1:
-        raise ValueError(f"{text!r} names {len(groups)} groups ({', '.join(groups[:6])}"
-                         + (", ..." if len(groups) > 6 else "") + f"): name one, and an atom {name} of it")
-    if not len(with_atom):
-        raise ValueError(f"no atom {name} in {groups[0]}")
-    return int(with_atom[0])
+        names = [_group_label(structure, int(row)) for row in rows[np.sort(first)][:6].tolist()]
+        raise ValueError(f"{text.strip()!r} names {len(groups)} groups ({', '.join(names)}"
+                         + (", ..." if len(groups) > 6 else "") + "): name one")
+    return rows
+
+
+def _group_label(structure: Structure, row: int) -> str:
+    """``A:HEM142``: the group of atom ``row``."""
+    atoms = structure.atoms
+    return f"{atoms.chain[row]}:{atoms.resname[row]}{atoms.resseq[row]}"
 
 
 def _atom_parts(text: str) -> tuple[str, str]:

@@ -107,7 +107,9 @@ def test_labels_angles_and_dihedrals_from_rw_are_gemmis_and_come_back_with_the_s
     assert 1.9 < iron < 2.4 and rw.measurements[-1] == f"A:HEM142 FE – A:HIS87 NE2: {iron:.2f} Å"
     rw.measure("A:HEM142 FE")  # and labelled
     assert rw.measurements[-1] == "A:HEM142 FE"
-    for _ in range(2):
+    rw.measure("/B:HEM")  # the whole group labelled
+    assert rw.measurements[-1] == "B:HEM148"
+    for _ in range(3):
         window.measurements_panel.table.selectRow(len(rw.measurements) - 1)
         window.measurements_panel.delete.click()
     saved = window.sessions.write_session(tmp_path / "measured")
