@@ -119,7 +119,8 @@ def run_info(args: argparse.Namespace) -> int:
           f"{report['altloc_atoms']} with altlocs); "
           + (f"model {report['model']} of {report['models']}" if report["models"] > 1 else "1 model"))
     if report["ligands"]:
-        print("  ligands and ions: " + ", ".join(f"{ligand['name']} ({ligand['count']})" for ligand in report["ligands"]))
+        print("  ligands and ions: " + ", ".join(f"{ligand['name']} ({ligand['count']})"
+                                                 for ligand in report["ligands"]))
     nucleic = [c for c in report["chains"] if c["nucleotides"]]
     if nucleic:
         print("  nucleic acids: " + ", ".join(f"chain {c['chain']} {c['nucleotides']} nucleotides"

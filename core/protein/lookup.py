@@ -62,9 +62,10 @@ def find_residues(structure: Structure, text: str, chain: str | None = None, coo
                   ) -> np.ndarray:
     """Residue-table rows named by ``text``, in increasing order: one residue (``A:45``, ``45``,
     ``A45``, ``A:LYS45``, ``A:52A``), a range (``A:40-50``), a whole chain (``/A``, ``chain A``),
-    the residues of a name (``resn HIS``, ``:his``: in every chain where none is named) or a list of them (``A:40-42, B:45``, ``/A:40-42,50``, ``resi 40-42+50``), in any syntax of
-    the module's; a part names ``chain`` when neither it nor a part before it in its list names
-    one (any chain when ``chain`` is None, the first that has it). Or the residues with an atom
+    the residues of a name (``resn HIS``, ``:his``: in every chain where none is named) or a
+    list of them (``A:40-42, B:45``, ``/A:40-42,50``, ``resi 40-42+50``), in any syntax of the
+    module's; a part names ``chain`` when neither it nor a part before it in its list names one
+    (any chain when ``chain`` is None, the first that has it). Or the residues with an atom
     within a distance of those or of a ligand's (``byres resn HEM around 5``), measured on
     ``coords`` (every atom's, Å; default: as read). Raises ValueError naming what is missing or
     how to type it."""

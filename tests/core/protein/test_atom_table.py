@@ -49,7 +49,7 @@ def test_read_atoms_accepts_dna_without_protein() -> None:
 
 
 def test_a_modified_nucleotide_of_a_dna_strand_is_a_nucleotide() -> None:
-    structure = read_structure(DATA / "4OPJ.pdb.gz")  # two DNA strands, the sixth nucleotide of each a modified one (TCY)
+    structure = read_structure(DATA / "4OPJ.pdb.gz")  # two DNA strands, the sixth nucleotide of each modified (TCY)
     atoms = structure.atoms
     tcy = atoms.resname == "TCY"
     assert tcy.any() and set(atoms.category[tcy].tolist()) == {"nucleic"}

@@ -52,7 +52,8 @@ def test_chimerax_and_pymol_forms(haemoglobin, text: str, chain: str | None, lab
     ("/A,B:41,50", None, ["A:THR41", "A:HIS50", "B:PHE41", "B:THR50"]),  # ChimeraX
     ("/A:40-41 /B:45", None, ["A:LYS40", "A:THR41", "B:PHE45"]), ("#1/C,D:3", None, ["C:SER3", "D:LEU3"]),
     ("resi 10+12+14", "C", ["C:VAL10", "C:ALA12", "C:TRP14"]),  # PyMOL
-    ("chain A+B and resi 5", None, ["A:ALA5", "B:PRO5"]), ("resi 40-41+50 and c. D", None, ["D:ARG40", "D:PHE41", "D:THR50"]),
+    ("chain A+B and resi 5", None, ["A:ALA5", "B:PRO5"]),
+    ("resi 40-41+50 and c. D", None, ["D:ARG40", "D:PHE41", "D:THR50"]),
     ("B:45, B:44-46", None, ["B:SER44", "B:PHE45", "B:GLY46"]),  # overlapping parts: each residue once
 ])
 def test_lists_of_residues_ranges_and_chains(haemoglobin, text: str, chain: str | None, labels: list[str]) -> None:
@@ -127,7 +128,8 @@ def test_insertion_codes() -> None:
     ("resi 45+", r"cannot read 'resi 45\+' as residues: type e.g. A:45.*ChimeraX /A:45-50.*PyMOL chain A and resi"),
     ("A:40-42, 999", "no residue 999 in chain A"), ("A:40,,", "cannot read"), ("/A,Z:5", "no chain Z"),
     ("resi " + "+".join(["45"] * 10_001), "names more than 10,000"),
-    ("A:87 around 99", "a distance of 99 Å: give one above 0 and at most 50 Å"), ("resn XYZ around 5", "no residue or ligand XYZ"),
+    ("A:87 around 99", "a distance of 99 Å: give one above 0 and at most 50 Å"),
+    ("resn XYZ around 5", "no residue or ligand XYZ"),
     ("resn HEM and chain Q around 5", "no residue or ligand HEM in chain Q"), ("A:999 around 5", "no residue A:999"),
     ("byres all", "cannot read 'byres all'"), ("chain A and chain B", "cannot read"), ("resn XYZ", "no residue XYZ"),
     ("chain A and resn ILE", "no residue ILE in chain A"),
