@@ -119,7 +119,8 @@ class EditorAPI:
         ChimeraX's ``'/A:40-50'``, PyMOL's ``'chain A and resi 40-50+60'``, a binding site
         ``'byres resn HEM around 5'``: :mod:`core.protein.lookup`) and
         centre the view on them, as Go to Residue (Ctrl+L) does; their chain becomes the edited
-        segment. Returns their labels (ValueError for a residue that does not exist)."""
+        segment. A ligand, ion, water or nucleotide (``'A:HEM'``, ``'/B:20'``) is centred on,
+        nothing selected. Returns the labels selected (ValueError for a residue that does not exist)."""
         document = self._document
         return [document.structure.residue_label(int(row)) for row in self._editor.navigation.go_to(residues)]
 

@@ -111,7 +111,7 @@ def _rows(structure: Structure, text: str, named: _Named, chain: str | None) -> 
     """The rows of one residue, range or chain, ``named`` by ``text``."""
     chains = [s.chain for s in structure.segments]
     if named.chain is not None and named.chain not in chains:
-        known = ", ".join(chain or "none (the file names no chain)" for chain in dict.fromkeys(chains))
+        known = ", ".join(chain or "none (the file names no chain)" for chain in dict.fromkeys(chains)) or "none"
         raise ValueError(f"no chain {named.chain} with a protein backbone (chains: {known})")
     if named.first is None:  # a whole chain, or the residues of a name (in every chain where none is named)
         segments = [s for s in structure.segments if named.chain in (None, s.chain)]

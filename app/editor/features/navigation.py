@@ -10,7 +10,7 @@ import numpy as np
 from PySide6.QtGui import QKeySequence
 from PySide6.QtWidgets import QLineEdit, QMainWindow, QStyle
 
-from core.protein.lookup import find_residues
+from core.protein.lookup import find_group, find_residues
 
 if TYPE_CHECKING:
     from app.editor.document import Document
@@ -80,12 +80,23 @@ class Navigation:
     def go_to(self, text: str) -> np.ndarray:
         """Select and centre on the residues named by ``text`` (``A:45``, ``45`` in the edited
         chain, ``A:40-50``, ``A:40-42, B:45``, or as ChimeraX and PyMOL name them, a binding site
-        too, measured as the atoms are now: :mod:`core.protein.lookup`);
-        returns their residue-table rows (raises ValueError)."""
+        too, measured as the atoms are now: :mod:`core.protein.lookup`), or centre on the
+        ligand, ion, water or nucleotide it names (``A:HEM``, ``/B:20``), selecting nothing;
+        returns the residue-table rows selected (raises ValueError)."""
         if self.document.model is None:
             raise ValueError("no structure is open")
-        chain = self.document.structure.segments[self.document.segment].chain
-        rows = find_residues(self.document.structure, text, chain, self.document.model.coords)
+        structure, coords = self.document.structure, self.document.model.coords
+        chain = structure.segments[self.document.segment].chain if structure.segments else None
+        try:
+            rows = find_residues(structure, text, chain, coords)
+        except ValueError:
+            group = find_group(structure, text, chain)
+            if group is None:
+                raise
+            self.document.select([])
+            self.scene.centre_on(coords[group].mean(axis=0))
+            self.plotter.render()
+            return np.empty(0, dtype=np.int64)
         self.select_and_centre(rows)
         return rows
 

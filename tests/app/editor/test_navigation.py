@@ -182,6 +182,34 @@ def test_go_to_a_binding_site_measures_the_atoms_where_they_are_now(open_window:
     assert "A:HIS87" not in [document.structure.residue_label(int(row)) for row in document.selection]
 
 
+def test_go_to_a_ligand_or_a_nucleotide_centres_on_it(open_window: Opener, qtbot: QtBot) -> None:
+    window = open_window("4HHB.pdb.gz")
+    atoms, coords = window.document.structure.atoms, window.document.model.coords
+    window.navigation.go_to("A:45")
+    assert window.navigation.go_to("/B:HEM").size == 0 and len(window.document.selection) == 0
+    haem = (atoms.resname == "HEM") & (atoms.chain == "B")
+    np.testing.assert_allclose(_focal(window), coords[haem].mean(axis=0), atol=1e-6)
+    window.navigation.go_to("resn HEM")  # the edited chain's (A's, since A:45)
+    np.testing.assert_allclose(_focal(window), coords[(atoms.resname == "HEM") & (atoms.chain == "A")].mean(axis=0),
+                               atol=1e-6)
+    with pytest.raises(ValueError, match="names 56 groups"):
+        window.navigation.go_to("/A:HOH")
+
+    window = open_window("1BNA.pdb.gz")  # DNA only: no residue of a backbone to select, its nucleotides to go to
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow)
+    qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+    qtbot.keyClicks(window.navigation.go_to_field, "B:20")
+    qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
+    atoms = window.document.structure.atoms
+    np.testing.assert_allclose(_focal(window), atoms.coords[(atoms.chain == "B") & (atoms.resseq == 20)].mean(axis=0),
+                               atol=1e-6)
+    qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+    qtbot.keyClicks(window.navigation.go_to_field, "A:500")
+    qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
+    assert window.statusBar().currentMessage() == "no chain A with a protein backbone (chains: none)"
+
+
 def test_double_click_centres_on_what_is_under_the_pointer(window: MainWindow, qtbot: QtBot) -> None:
     window.scene.set_layer(Layer.CONTROL_POINTS, False)
     row = _front_residue(window, np.arange(40, 60))
