@@ -132,11 +132,13 @@ class EditorAPI:
         none is named). Returns the value (Å or degrees; None for a label)."""
         document = self._document
         chain = document.structure.segments[document.segment].chain if document.editable else None
-        if len(atoms) == 1 and isinstance(atoms[0], str) and document.editable:
-            try:
-                rows = find_residues(document.structure, atoms[0], chain)
-            except ValueError:
-                rows = []
+        if len(atoms) == 1 and isinstance(atoms[0], str):
+            rows = []
+            if document.editable:
+                try:
+                    rows = find_residues(document.structure, atoms[0], chain)
+                except ValueError:
+                    rows = []
             if len(rows) == 1:  # a residue: its label
                 document.measurements.add([int(document.ca_rows[rows[0]])], len(document.model.coords), True)
                 return None

@@ -130,11 +130,11 @@ def topology(structure: Structure) -> Topology:
     """The validation set-up of ``structure`` (cached: structures are immutable)."""
     atoms = structure.atoms
     backbone = _backbone_rows(structure)
-    segment_of = np.concatenate([np.full(len(s), k) for k, s in enumerate(structure.segments)])
+    segment_of = np.concatenate([np.full(len(s), k) for k, s in enumerate(structure.segments)] or [np.empty(0, int)])
     first = np.flatnonzero(segment_of[:-1] == segment_of[1:])
     second = first + 1
-    resname = np.concatenate([s.resname for s in structure.segments])
-    labels = np.concatenate([np.array(s.labels, dtype=str) for s in structure.segments])
+    resname = np.concatenate([s.resname for s in structure.segments] or [np.empty(0, str)])
+    labels = np.concatenate([np.array(s.labels, dtype=str) for s in structure.segments] or [np.empty(0, str)])
     coords = structure.coords
     omega = _junction_dihedral(coords, backbone, first, second)
     rama_class = np.select([resname == "GLY", resname == "PRO"], [1, 2], 0).astype(np.int8)
@@ -167,7 +167,7 @@ def _backbone_rows(structure: Structure) -> np.ndarray:
     n_residues = structure.n_residues
     rows = np.full((n_residues, 4), -1, dtype=np.int64)
     for slot, name in enumerate(("N", "CA", "C", "O")):
-        reference = np.concatenate([getattr(s, name.lower()) for s in structure.segments])
+        reference = np.concatenate([getattr(s, name.lower()) for s in structure.segments] or [np.empty((0, 3))])
         candidates = np.flatnonzero((atoms.name == name) & (owner >= 0))
         same = np.all(structure.coords[candidates] == reference[owner[candidates]], axis=1)
         candidates = candidates[same]

@@ -19,7 +19,8 @@ from core.protein.structure import Structure
 
 _NUMBERS = r"(?P<first>-?\d+)(?P<icode>[A-Za-z]?)(?:\s*(?:-|–|\.\.)\s*(?P<last>-?\d+)(?P<last_icode>[A-Za-z]?))?"
 _CHAIN = r"[A-Za-z0-9]{1,4}"
-_OWN = re.compile(rf"(?:(?P<chain>{_CHAIN})\s*[:/]\s*|(?P<letter>[A-Za-z])(?=-?\d))?(?P<name>[A-Za-z]{{3}})?{_NUMBERS}")
+_OWN = re.compile(rf"(?:(?P<chain>{_CHAIN})\s*[:/]\s*|(?P<letter>[A-Za-z])(?=-?\d))?"
+                  rf"(?P<name>[A-Za-z]{{1,3}})?{_NUMBERS}")
 _NAME = r"(?=[A-Za-z0-9]*[A-Za-z])[A-Za-z0-9]{1,5}"
 """A residue or ligand name (HIS, PO4, 5CM, A): letters and digits, at least one letter."""
 _CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{_CHAIN}))?\s*(?::(?:{_NUMBERS}|(?P<name>{_NAME})))?")
@@ -168,11 +169,33 @@ def find_group(structure: Structure, text: str, chain: str | None = None) -> np.
     (``A:142``, ``A:HEM142``, ``/A:HEM``, ``resn HEM``) or ``A:HEM``, in ``chain`` when the
     text names none and that chain has it. None where the text names no such group;
     ValueError where it names several."""
-    named, own = _read(text.strip()), False
-    if named is None and (match := re.fullmatch(rf"(?P<chain>{_CHAIN})\s*:\s*(?P<name>{_NAME})", text.strip())):
-        named, own = _Named(match["chain"], name=match["name"]), True
-    if named is None or named.last is not None or (named.first is None and named.name is None):
+    readings = [_read(text.strip())]  # B:PO4 reads as residue 4 named PO, and as the group PO4 of chain B
+    if match := re.fullmatch(rf"(?P<chain>{_CHAIN})\s*:\s*(?P<name>{_NAME})", text.strip()):
+        readings.append(_Named(match["chain"], name=match["name"]))
+    readings = [named for named in readings if named is not None and named.last is None
+                and (named.first is not None or named.name is not None)]
+    if not readings:
         return None
+    rows = np.empty(0, dtype=np.int64)
+    for named in readings:
+        rows = np.flatnonzero(_group_atoms(structure, named, chain))
+        if len(rows):
+            break
+    if not len(rows):
+        if match:
+            raise ValueError(f"no residue or group {match['name'].upper()} in chain {match['chain']}")
+        return None
+    groups, first = np.unique(structure.atoms.residue[rows], return_index=True)
+    if len(groups) > 1:
+        names = [_group_label(structure, int(row)) for row in rows[np.sort(first)][:6].tolist()]
+        raise ValueError(f"{text.strip()!r} names {len(groups)} groups ({', '.join(names)}"
+                         + (", ..." if len(groups) > 6 else "") + "): name one")
+    return rows
+
+
+def _group_atoms(structure: Structure, named: _Named, chain: str | None) -> np.ndarray:
+    """(n_atoms,) bool: the atoms outside the backbone segments of the groups ``named``, in
+    ``chain`` when it names none and that chain has them."""
     atoms = structure.atoms
     chosen = structure.atom_residue < 0
     if named.first is not None:
@@ -182,17 +205,7 @@ def find_group(structure: Structure, text: str, chain: str | None = None) -> np.
     where = named.chain if named.chain is not None else chain
     if where is not None and (named.chain is not None or (chosen & (atoms.chain == where)).any()):
         chosen &= atoms.chain == where
-    rows = np.flatnonzero(chosen)
-    if not len(rows):
-        if own:
-            raise ValueError(f"no residue or group {named.name.upper()} in chain {named.chain}")
-        return None
-    groups, first = np.unique(atoms.residue[rows], return_index=True)
-    if len(groups) > 1:
-        names = [_group_label(structure, int(row)) for row in rows[np.sort(first)][:6].tolist()]
-        raise ValueError(f"{text.strip()!r} names {len(groups)} groups ({', '.join(names)}"
-                         + (", ..." if len(groups) > 6 else "") + "): name one")
-    return rows
+    return chosen
 
 
 def _group_label(structure: Structure, row: int) -> str:

@@ -104,6 +104,17 @@ def test_dna_opens_in_the_window_for_viewing_and_surfaces(qtbot: QtBot, tmp_path
     qtbot.waitUntil(lambda: surfaces.layer.built is not None, timeout=BUILD_TIMEOUT_MS)
     assert window.plotter.actors["surface"].mapper.dataset.n_cells > 1000
 
+    # its atoms are measured, labelled and gone to by name, as a protein's are
+    rw = window.rw
+    rise = rw.measure("A:DG4 P", "/A:5@P")  # one phosphate to the next along a strand
+    assert 5.5 < rise < 7.5 and rw.measure("B:DT20") is None
+    assert rw.measurements == [f"A:DG4 P – A:DA5 P: {rise:.2f} Å", "B:DT20"]
+    assert window.measurements_panel.table.rowCount() == 2
+    assert rw.go_to("B:20") == [] and len(document.selection) == 0
+    for _ in range(2):
+        window.measurements_panel.table.selectRow(0)
+        window.measurements_panel.delete.click()
+
     # saving unchanged writes the file as read
     assert window.files.write(tmp_path / "1bna.pdb")
     assert (tmp_path / "1bna.pdb").read_bytes() == gzip.decompress(DNA.read_bytes())

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.protein.lookup import find_atom, find_residues
+from core.protein.lookup import find_atom, find_group, find_residues
 from core.protein.reading import read_structure
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -183,6 +183,16 @@ def test_an_atom_of_a_ligand_in_each_syntax(haemoglobin, text: str, chain: str |
 def test_a_ligand_atom_not_named_once_is_said_so(haemoglobin, text: str, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         find_atom(haemoglobin, text)
+
+
+def test_a_nucleotide_and_an_ion_named_like_a_residue() -> None:
+    dna = read_structure(DATA / "1BNA.pdb.gz", require_protein=False)
+    row = find_atom(dna, "B:DG16 P")  # a two-letter name
+    assert (dna.atoms.chain[row], dna.atoms.resname[row], dna.atoms.resseq[row]) == ("B", "DG", 16)
+    assert find_atom(dna, "/B:16@P") == row and set(dna.atoms.resseq[find_group(dna, "A:DA5")].tolist()) == {5}
+    haemoglobin = read_structure(DATA / "4HHB.pdb.gz")
+    phosphorus = find_atom(haemoglobin, "B:PO4 P")  # read as the group PO4 when no residue 4 is named PO
+    assert (haemoglobin.atoms.chain[phosphorus], haemoglobin.atoms.resname[phosphorus]) == ("B", "PO4")
 
 
 def test_a_file_that_names_no_chain_says_so() -> None:
