@@ -99,7 +99,8 @@ def cylinder(surface: MolecularSurface, *, level: int = LEVEL, samples: int = SA
     foot = centre + z[..., None] * axes[2]
     reach = _reach(surface, centre)
     depth = surface.field.cast_rays((foot + reach * radial).reshape(-1, 3), -radial.reshape(-1, 3), reach)
-    _check_hits(depth, surface, "the axis")
+    _check_hits(depth, surface, "the axis",
+                ": a cylinder fits one straight duplex (or molecule) along its longest axis")
     points = foot + (reach - depth.reshape(z.shape))[..., None] * radial
     return ShapeSurface(fit_surface(points, level, (False, True)), centre + (low + high) / 2 * axes[2], axes)
 
@@ -110,9 +111,9 @@ def _reach(surface: MolecularSurface, centre: np.ndarray) -> float:
     return float(np.linalg.norm(coords - centre, axis=1).max() + 10.0)
 
 
-def _check_hits(depth: np.ndarray, surface: MolecularSurface, target: str) -> None:
+def _check_hits(depth: np.ndarray, surface: MolecularSurface, target: str, hint: str = "") -> None:
     missed = int(np.isnan(depth).sum())
     if missed:
         raise ValueError(
-            f"{surface.atoms.entry_id}: {missed} of {len(depth)} rays towards {target} miss the molecular surface"
+            f"{surface.atoms.entry_id}: {missed} of {len(depth)} rays towards {target} miss the molecular surface{hint}"
         )

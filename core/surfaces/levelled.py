@@ -108,7 +108,10 @@ def build_surface(
             density = model_density(_needed(atoms))
         return _map_surface(density, atoms, contour, report)
     atoms = _needed(atoms)
-    surface = molecular_surface(atoms, probe=probe, spacing=spacing, exclude=site,
+    exclude = site
+    if kind == "dna" and (nucleic := atoms.category == "nucleic").any():  # the duplex alone, not what binds it
+        exclude = ~nucleic if site is None else site | ~nucleic
+    surface = molecular_surface(atoms, probe=probe, spacing=spacing, exclude=exclude,
                                 progress=lambda stage: report(f"molecular surface ({stage})"))
     colour = partial(_surface_colour, surface)
     if kind == "ses":

@@ -41,3 +41,13 @@ def test_stages_are_named_and_the_surface_pickles(kind: str, stages: list[str]) 
             np.testing.assert_array_equal(copied.faces, mesh.faces)
             if colouring is not None:
                 np.testing.assert_allclose(copied_values, values, rtol=1e-9, atol=1e-12)
+
+
+def test_the_dna_cylinder_of_a_protein_dna_complex_is_its_duplex_alone() -> None:
+    atoms = read_atoms(DATA / "1LCD.cif.gz")  # the lac repressor headpiece on an 11-base-pair operator
+    mesh, _ = build_surface("dna", atoms).view()  # (about the whole complex, rays missed it between the two)
+    dna = atoms.coords[atoms.category == "nucleic"]
+    near_dna = np.linalg.norm(mesh.vertices[:, None] - dna[None], axis=2).min(axis=1)
+    assert np.percentile(near_dna, 99) < 4.0  # on the duplex, not on the protein
+    axis = np.linalg.svd(dna - dna.mean(axis=0))[2][0]
+    assert np.ptp(mesh.vertices @ axis) < np.ptp(dna @ axis)  # along the duplex, within its length
