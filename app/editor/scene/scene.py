@@ -28,7 +28,7 @@ from app.editor.scene.layers.cartoon import CartoonLayer
 from app.editor.scene.layers.chains import DIM_ABOVE_CHAINS, Chains, Others, faded
 from app.editor.scene.layers.control_points import ControlPointsLayer
 from app.editor.scene.layers.level_curve import CurveLayer
-from app.editor.scene.layers.ligands import IonsLayer, LigandsLayer
+from app.editor.scene.layers.ligands import IonsLayer, LigandsLayer, WatersLayer
 from app.editor.scene.layers.measurements import MeasurementsLayer
 from app.editor.scene.layers.models import ModelsLayer
 from app.editor.scene.layers.nucleic import NucleicLayer
@@ -53,6 +53,7 @@ LAYERS: tuple[type[SceneLayer], ...] = (
     ModelsLayer,
     LigandsLayer,
     IonsLayer,
+    WatersLayer,
     MeasurementsLayer,
 )
 """The layers every scene draws, in this order (the validation markers add themselves)."""

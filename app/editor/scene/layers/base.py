@@ -43,6 +43,7 @@ class Layer(StrEnum):
     MODELS = "other models"
     LIGANDS = "ligands"
     IONS = "ions"
+    WATERS = "waters"
     VALIDATION = "validation markers"
     MEASUREMENTS = "measurements"
 

@@ -1,7 +1,8 @@
-"""Ligands (balls and sticks, carbon in green: ``ligand_balls``, ``ligand_sticks``) and ions (a
-large ball each: ``ions``), two layers switched on their own; also drawn for a structure that
-is only viewed (no backbone). An edit moves those bound to the residues it moves (see
-:meth:`core.protein.model.EditableModel.bound_ligands`)."""
+"""Ligands (balls and sticks, carbon in green: ``ligand_balls``, ``ligand_sticks``), ions (a
+large ball each: ``ions``) and waters (a small red ball at each oxygen: ``waters``, off at
+first, as a crystal's hundreds crowd the view), three layers switched on their own; also drawn
+for a structure that is only viewed (no backbone). An edit moves the ligands and ions bound to
+the residues it moves (see :meth:`core.protein.model.EditableModel.bound_ligands`)."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ if TYPE_CHECKING:
 
 LIGAND_ATOM_RADIUS = 0.35
 ION_RADIUS = 1.1
+WATER_RADIUS = 0.3
 
 
 class LigandsLayer(SceneLayer):
@@ -94,6 +96,31 @@ class IonsLayer(SceneLayer):
     def restore(self) -> None:
         if self.meshes["ions"].n_points:
             move_glyphs(self.meshes["ions"], slice(None), self.document.model.coords[self._rows])
+
+
+class WatersLayer(SceneLayer):
+    """Waters as a small ball at each oxygen (every alternate location)."""
+
+    switch = Layer.WATERS
+    needs_backbone = False
+    names = ("waters",)
+
+    def build(self) -> None:
+        table = self.document.structure.atoms
+        self._rows = np.flatnonzero((table.category == "water") & (np.char.upper(table.element.astype(str)) == "O"))
+        self.meshes["waters"] = glyphs(self.document.model.coords[self._rows], WATER_RADIUS,
+                                       molecule.element_colours(table.element[self._rows]))
+        self.add("waters", scalars="colours", rgb=True, **SHINY)
+
+    def atom_rows(self) -> np.ndarray:
+        return self._rows
+
+    def conceal(self, chain: str) -> None:
+        _conceal_glyphs(self.meshes["waters"], self.document.structure.atoms.chain[self._rows] != chain)
+
+    def restore(self) -> None:
+        if self.meshes["waters"].n_points:
+            move_glyphs(self.meshes["waters"], slice(None), self.document.model.coords[self._rows])
 
 
 def _conceal_glyphs(mesh: pv.PolyData, other: np.ndarray) -> None:
