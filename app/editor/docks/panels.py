@@ -215,7 +215,8 @@ class DisplayPanel(QWidget):
         super().__init__(parent)
         self.scene = scene
         layers = QGroupBox("Layers")
-        layer_box = QGridLayout(layers)  # three columns: the dock fits a laptop's height
+        layer_box = QGridLayout(layers)  # three columns, rows close together: the dock fits a laptop's height
+        layer_box.setVerticalSpacing(2)
         self.layer_boxes: dict[Layer, QCheckBox] = {}
         for k, layer in enumerate(Layer):
             box = QCheckBox(layer.value[0].upper() + layer.value[1:])
