@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import numpy as np
 from PySide6.QtWidgets import QLabel, QStatusBar
 
 from app.editor.interaction.drag import Mode
@@ -54,9 +55,7 @@ class StatusBar:
         labels["level"].setText(f"level {document.shown_level():.2f} / {document.max_level:.2f}")
         pick = document.pick
         if len(document.selection) and pick is None:
-            first, last = (document.structure.residue_label(int(r)) for r in document.selection[[0, -1]])
-            labels["pick"].setText(f"selected {first if first == last else f'{first}–{last}'} "
-                                   f"({len(document.selection)} residues); Esc clears")
+            labels["pick"].setText(f"selected {selection_text(document)}; Esc clears")
             return
         idle = ("Click a control point to pick it; drag it to edit." if self.controller.mode is Mode.POINT
                 else "Drag the curve to tug it.")
@@ -68,3 +67,16 @@ class StatusBar:
     def _update_correlation(self) -> None:
         value = self.correlation.value
         self.labels["map"].setText("" if value is None else f"map CC {value:.3f}")
+
+
+def selection_text(document: Document, named: int = 4) -> str:
+    """The selected residues in a few words: a run as ``A:LYS40–A:TYR42 (3 residues)``, others
+    as ``13 residues: A:ASP189, A:SER190, A:CYS191 … A:TYR228`` (the first ``named`` and the last)."""
+    rows = document.selection
+    label = document.structure.residue_label
+    segments = document.structure.residue_place(rows)[0]
+    if np.all(np.diff(rows) == 1) and len(set(segments.tolist())) == 1:  # one run
+        first, last = label(int(rows[0])), label(int(rows[-1]))
+        return f"{first if first == last else f'{first}–{last}'} ({len(rows)} residues)"
+    shown = ", ".join(label(int(row)) for row in rows[:named])
+    return f"{len(rows)} residues: {shown}" + (f" … {label(int(rows[-1]))}" if len(rows) > named else "")

@@ -139,6 +139,8 @@ def test_go_to_residue_by_keyboard(window: MainWindow, qtbot: QtBot) -> None:
         qtbot.keyClicks(window.navigation.go_to_field, typed)
         qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
         assert list(window.document.selection) == [29, 30, 31, 39], typed
+        assert window.status.labels["pick"].text() == ("selected 4 residues: A:ILE30, A:GLN31, A:ASP32, "
+                                                       "A:GLN40; Esc clears"), typed
         np.testing.assert_allclose(_focal(window), np.mean([_ca(window, r) for r in (29, 30, 31, 39)], axis=0),
                                    atol=1e-6)
     window.navigation.go_to("30-35")
