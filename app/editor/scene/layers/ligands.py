@@ -6,7 +6,7 @@ the residues it moves (see :meth:`core.protein.model.EditableModel.bound_ligands
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 import pyvista as pv
@@ -68,19 +68,22 @@ class LigandsLayer(SceneLayer):
             self.write("ligand_sticks", slice(None), coords)
 
 
-class IonsLayer(SceneLayer):
-    """Ions (a non-polymer, non-water group of one heavy atom) as balls."""
+class _BallsLayer(SceneLayer):
+    """Atoms of one kind as balls of one radius, coloured by element."""
 
-    switch = Layer.IONS
     needs_backbone = False
-    names = ("ions",)
+    radius: ClassVar[float]
+
+    def chosen(self) -> np.ndarray:
+        """Rows of the atoms it draws."""
+        raise NotImplementedError
 
     def build(self) -> None:
-        elements = self.document.structure.atoms.element
-        self._rows, _ = molecule.ions_and_ligands(self.document.structure)
-        self.meshes["ions"] = glyphs(self.document.model.coords[self._rows], ION_RADIUS,
-                                     molecule.element_colours(elements[self._rows]))
-        self.add("ions", scalars="colours", rgb=True, **SHINY)
+        (name,) = self.names
+        self._rows = self.chosen()
+        self.meshes[name] = glyphs(self.document.model.coords[self._rows], self.radius,
+                                   molecule.element_colours(self.document.structure.atoms.element[self._rows]))
+        self.add(name, scalars="colours", rgb=True, **SHINY)
 
     def atom_rows(self) -> np.ndarray:
         return self._rows
@@ -88,39 +91,37 @@ class IonsLayer(SceneLayer):
     def update(self, change: Change) -> None:
         moved = np.flatnonzero(np.isin(self._rows, change.rows))
         if len(moved):
-            move_glyphs(self.meshes["ions"], moved, self.document.model.coords[self._rows[moved]])
+            move_glyphs(self.meshes[self.names[0]], moved, self.document.model.coords[self._rows[moved]])
 
     def conceal(self, chain: str) -> None:
-        _conceal_glyphs(self.meshes["ions"], self.document.structure.atoms.chain[self._rows] != chain)
+        _conceal_glyphs(self.meshes[self.names[0]], self.document.structure.atoms.chain[self._rows] != chain)
 
     def restore(self) -> None:
-        if self.meshes["ions"].n_points:
-            move_glyphs(self.meshes["ions"], slice(None), self.document.model.coords[self._rows])
+        if self.meshes[self.names[0]].n_points:
+            move_glyphs(self.meshes[self.names[0]], slice(None), self.document.model.coords[self._rows])
 
 
-class WatersLayer(SceneLayer):
+class IonsLayer(_BallsLayer):
+    """Ions (a non-polymer, non-water group of one heavy atom) as balls."""
+
+    switch = Layer.IONS
+    names = ("ions",)
+    radius = ION_RADIUS
+
+    def chosen(self) -> np.ndarray:
+        return molecule.ions_and_ligands(self.document.structure)[0]
+
+
+class WatersLayer(_BallsLayer):
     """Waters as a small ball at each oxygen (every alternate location)."""
 
     switch = Layer.WATERS
-    needs_backbone = False
     names = ("waters",)
+    radius = WATER_RADIUS
 
-    def build(self) -> None:
+    def chosen(self) -> np.ndarray:
         table = self.document.structure.atoms
-        self._rows = np.flatnonzero((table.category == "water") & (np.char.upper(table.element.astype(str)) == "O"))
-        self.meshes["waters"] = glyphs(self.document.model.coords[self._rows], WATER_RADIUS,
-                                       molecule.element_colours(table.element[self._rows]))
-        self.add("waters", scalars="colours", rgb=True, **SHINY)
-
-    def atom_rows(self) -> np.ndarray:
-        return self._rows
-
-    def conceal(self, chain: str) -> None:
-        _conceal_glyphs(self.meshes["waters"], self.document.structure.atoms.chain[self._rows] != chain)
-
-    def restore(self) -> None:
-        if self.meshes["waters"].n_points:
-            move_glyphs(self.meshes["waters"], slice(None), self.document.model.coords[self._rows])
+        return np.flatnonzero((table.category == "water") & (np.char.upper(table.element.astype(str)) == "O"))
 
 
 def _conceal_glyphs(mesh: pv.PolyData, other: np.ndarray) -> None:
