@@ -8,6 +8,7 @@ written as File ▸ Save writes them. Errors are exceptions, never dialogs.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
@@ -135,10 +136,8 @@ class EditorAPI:
         if len(atoms) == 1 and isinstance(atoms[0], str):
             rows = []
             if document.editable:
-                try:
+                with contextlib.suppress(ValueError):  # not a residue: a group, or an atom, below
                     rows = find_residues(document.structure, atoms[0], chain)
-                except ValueError:
-                    rows = []
             if len(rows) == 1:  # a residue: its label
                 document.measurements.add([int(document.ca_rows[rows[0]])], len(document.model.coords), True)
                 return None

@@ -116,10 +116,10 @@ def _rows(structure: Structure, text: str, named: _Named, chain: str | None) -> 
         raise ValueError(f"no chain {named.chain} with a protein backbone (chains: {known})")
     if named.first is None:  # a whole chain, or the residues of a name (in every chain where none is named)
         segments = [s for s in structure.segments if named.chain in (None, s.chain)]
-        rows = np.concatenate([s.residue_index for s in segments])
+        rows = np.concatenate([s.residue_index for s in segments] or [np.empty(0, dtype=np.int64)])
         if named.name is None:
             return rows
-        rows = rows[np.concatenate([s.resname for s in segments]) == named.name.upper()]
+        rows = rows[np.concatenate([s.resname for s in segments] or [np.empty(0, dtype=str)]) == named.name.upper()]
         if not len(rows):
             raise ValueError(f"no residue {named.name.upper()}" + (f" in chain {named.chain}" if named.chain else ""))
         return rows

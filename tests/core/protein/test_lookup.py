@@ -190,6 +190,8 @@ def test_a_nucleotide_and_an_ion_named_like_a_residue() -> None:
     row = find_atom(dna, "B:DG16 P")  # a two-letter name
     assert (dna.atoms.chain[row], dna.atoms.resname[row], dna.atoms.resseq[row]) == ("B", "DG", 16)
     assert find_atom(dna, "/B:16@P") == row and set(dna.atoms.resseq[find_group(dna, "A:DA5")].tolist()) == {5}
+    with pytest.raises(ValueError, match="no residue DA"):  # no backbone to find residues in
+        find_residues(dna, "resn DA")
     haemoglobin = read_structure(DATA / "4HHB.pdb.gz")
     phosphorus = find_atom(haemoglobin, "B:PO4 P")  # read as the group PO4 when no residue 4 is named PO
     assert (haemoglobin.atoms.chain[phosphorus], haemoglobin.atoms.resname[phosphorus]) == ("B", "PO4")

@@ -79,11 +79,14 @@ class _BallsLayer(SceneLayer):
         raise NotImplementedError
 
     def build(self) -> None:
-        (name,) = self.names
         self._rows = self.chosen()
-        self.meshes[name] = glyphs(self.document.model.coords[self._rows], self.radius,
-                                   molecule.element_colours(self.document.structure.atoms.element[self._rows]))
-        self.add(name, scalars="colours", rgb=True, **SHINY)
+        self.meshes[self.names[0]] = glyphs(self.document.model.coords[self._rows], self.radius,
+                                            molecule.element_colours(self.document.structure.atoms.element[self._rows]))
+        self.add(self.names[0], scalars="colours", rgb=True, **SHINY)
+
+    @property
+    def _balls(self) -> pv.PolyData:
+        return self.meshes[self.names[0]]
 
     def atom_rows(self) -> np.ndarray:
         return self._rows
@@ -91,14 +94,14 @@ class _BallsLayer(SceneLayer):
     def update(self, change: Change) -> None:
         moved = np.flatnonzero(np.isin(self._rows, change.rows))
         if len(moved):
-            move_glyphs(self.meshes[self.names[0]], moved, self.document.model.coords[self._rows[moved]])
+            move_glyphs(self._balls, moved, self.document.model.coords[self._rows[moved]])
 
     def conceal(self, chain: str) -> None:
-        _conceal_glyphs(self.meshes[self.names[0]], self.document.structure.atoms.chain[self._rows] != chain)
+        _conceal_glyphs(self._balls, self.document.structure.atoms.chain[self._rows] != chain)
 
     def restore(self) -> None:
-        if self.meshes[self.names[0]].n_points:
-            move_glyphs(self.meshes[self.names[0]], slice(None), self.document.model.coords[self._rows])
+        if self._balls.n_points:
+            move_glyphs(self._balls, slice(None), self.document.model.coords[self._rows])
 
 
 class IonsLayer(_BallsLayer):
