@@ -17,7 +17,7 @@ import numpy as np
 
 from core.protein.input_files import StructureError, looks_like_mmcif, read_bytes, text_of
 from core.protein.parsing import info, parse
-from core.protein.scanning import ScannedModel, scan_model
+from core.protein.scanning import ScannedModel, modified_parents, scan_model
 from core.protein.segments import (
     atom_residue,
     backbone_runs,
@@ -128,7 +128,7 @@ def _read_model(path: Path, data: bytes, model: int) -> tuple[str, str, str, gem
     file with finite atoms."""
     text, encoding, fmt, st = _parsed(path, data, model)
     try:
-        atoms = scan_model(st[int(model) - 1])
+        atoms = scan_model(st[int(model) - 1], modified_parents(st))
     except (TypeError, ValueError, RuntimeError) as exc:  # e.g. a residue gemmi left without a number
         raise StructureError(f"{path}: cannot read the atoms ({exc})") from None
     if len(atoms.coords) == 0:
@@ -161,6 +161,7 @@ def _atom_table(entry_id: str, atoms: ScannedModel) -> AtomTable:
         b_factor=frozen(np.array(atoms.b_factor, dtype=np.float64)),
         occupancy=frozen(np.array(atoms.occupancy, dtype=np.float64)),
         category=per_atom(category, str),
+        parents=atoms.parents,
     )
 
 

@@ -43,6 +43,7 @@ class ScannedModel:
     n_hetero: int
     n_water: int
     n_altloc: int
+    parents: dict[str, str]  # modified residue name -> its standard parent, as the file records it
 
 
 def _element(atom: gemmi.Atom, standard: bool) -> str:
@@ -55,8 +56,9 @@ def _element(atom: gemmi.Atom, standard: bool) -> str:
     return letters[:1].upper() if letters[:1].upper() in _POLYMER_ELEMENTS else name
 
 
-def scan_model(model: gemmi.Model) -> ScannedModel:
-    """Walk the model once (chain, residue, atom) and collect everything needed."""
+def scan_model(model: gemmi.Model, parents: dict[str, str]) -> ScannedModel:
+    """Walk the model once (chain, residue, atom) and collect everything needed; ``parents``
+    (see :func:`modified_parents`) is passed on."""
     xyz: list[tuple[float, float, float]] = []
     chain, part, seq, icode, resname, protein, start, stop, backbone = ([] for _ in range(9))
     nucleic, water, atom_name, element, altloc, b_factor, occupancy = ([] for _ in range(7))
@@ -128,4 +130,11 @@ def scan_model(model: gemmi.Model) -> ScannedModel:
         n_hetero=n_hetero,
         n_water=n_water,
         n_altloc=n_altloc,
+        parents=parents,
     )
+
+
+def modified_parents(st: gemmi.Structure) -> dict[str, str]:
+    """The standard parent of each modified residue by name, from the file's PDB MODRES or
+    mmCIF ``_pdbx_struct_mod_residue`` records: ``{'TCY': 'DA'}`` in 4OPJ."""
+    return {m.res_id.name: m.parent_comp_id for m in st.mod_residues if m.parent_comp_id.strip()}

@@ -18,6 +18,7 @@ from core.protein.structure import (
     SS_FROM_PDB_RECORDS,
     BackboneSegment,
     ChainSummary,
+    amino_acid_letter,
     frozen,
 )
 
@@ -163,6 +164,7 @@ def make_segments(
                 residue_index=frozen(np.arange(offset, offset + count, dtype=np.int64)),
                 atom_start=frozen(groups.start[run]),
                 atom_stop=frozen(groups.stop[run]),
+                sequence="".join(amino_acid_letter(atoms.resname[r], atoms.parents) for r in res),
             )
         )
         offset += count
@@ -192,18 +194,21 @@ def chain_summaries(atoms: ScannedModel, segments: tuple[BackboneSegment, ...]) 
             n_backbone=sum(len(s) for s in segments if s.chain == name),
             n_segments=sum(1 for s in segments if s.chain == name),
             n_nucleotides=len(nucleotides[name]),
-            nucleic_acid=_nucleic_acid_kind(nucleotides[name]),
+            nucleic_acid=_nucleic_acid_kind(nucleotides[name], atoms.parents),
         )
         for name in names
     )
 
 
-def _nucleic_acid_kind(resnames: list[str]) -> str:
+def _nucleic_acid_kind(resnames: list[str], parents: dict[str, str]) -> str:
     """'DNA', 'RNA' or 'DNA/RNA' by the kinds of nucleotide names gemmi tabulates (DA is DNA,
-    A and PSU are RNA); '' where none of the names is of a known kind."""
+    A and PSU are RNA), a modified one gemmi lacks by its parent's (``parents``); '' where
+    none of the names is of a known kind."""
     kinds = set()
     for name in set(resnames):
         tabulated = gemmi.find_tabulated_residue(name)
+        if tabulated is not None and not tabulated.is_nucleic_acid() and name in parents:
+            tabulated = gemmi.find_tabulated_residue(parents[name])
         if tabulated is not None and tabulated.kind in (gemmi.ResidueKind.DNA, gemmi.ResidueKind.RNA):
             kinds.add("DNA" if tabulated.kind == gemmi.ResidueKind.DNA else "RNA")
     return "/".join(sorted(kinds))

@@ -30,6 +30,7 @@ Conventions
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cache, cached_property
 from pathlib import Path
@@ -70,6 +71,8 @@ class BackboneSegment:
     atom_start, atom_stop : (N,) int64
         Residue i owns rows ``atom_start[i]:atom_stop[i]`` of ``Structure.coords``: all
         its atoms, alternate locations and hydrogens included.
+    sequence : str
+        One-letter codes of the residues (:func:`amino_acid_letter`).
     """
 
     chain: str
@@ -84,6 +87,7 @@ class BackboneSegment:
     residue_index: NDArray[np.int64]
     atom_start: NDArray[np.int64]
     atom_stop: NDArray[np.int64]
+    sequence: str
 
     def __len__(self) -> int:
         return len(self.resseq)
@@ -100,31 +104,34 @@ class BackboneSegment:
             for name, num, ic in zip(self.resname, self.resseq.tolist(), self.icode, strict=True)
         )
 
-    @cached_property
-    def sequence(self) -> str:
-        """One-letter codes of the residues (modified ones as their parent, 'X' if unknown)."""
-        return "".join(_one_letter(name) for name in self.resname)
-
     @property
     def summary(self) -> str:
         """E.g. ``'A  MET1–GLY76 (76 residues)'``."""
         return f"{self.chain}  {self.labels[0].split(':')[1]}–{self.labels[-1].split(':')[1]} ({len(self)} residues)"
 
 
-def _one_letter(name: str) -> str:
-    residue = gemmi.find_tabulated_residue(name)
-    code = residue.one_letter_code.upper() if residue is not None else " "
-    return code if code.strip() else "X"
-
-
 @cache
-def nucleotide_letter(name: str) -> str:
-    """A nucleotide's one-letter code by its residue name: A, C, G, T, U (I: inosine) for the
-    standard ones, its parent's in lower case for a modified one gemmi tabulates (PSU u,
-    5CM c), N (any nucleotide) for another."""
+def _tabulated_letter(name: str) -> str:
+    """gemmi's one-letter code of a residue name (lower case for a modified residue), '' if none."""
     residue = gemmi.find_tabulated_residue(name.strip())
-    code = residue.one_letter_code if residue is not None else " "
-    return code if code.strip() else "N"
+    return residue.one_letter_code.strip() if residue is not None else ""
+
+
+def amino_acid_letter(name: str, parents: Mapping[str, str] | None = None) -> str:
+    """An amino acid's one-letter code by its residue name; a modified one as its parent, by
+    gemmi's table (MSE M) or else by the file's own record of it (``parents``, e.g.
+    :attr:`AtomTable.parents`: TRN, a Trp, W); X if unknown."""
+    code = _tabulated_letter(name) or _tabulated_letter(parents.get(name, "") if parents else "")
+    return code.upper() or "X"
+
+
+def nucleotide_letter(name: str, parents: Mapping[str, str] | None = None) -> str:
+    """A nucleotide's one-letter code by its residue name: A, C, G, T, U (I: inosine) for the
+    standard ones, its parent's in lower case for a modified one, by gemmi's table (PSU u,
+    5CM c) or else by the file's own record of it (``parents``: TCY, a dA, a); N (any
+    nucleotide) if unknown."""
+    code = _tabulated_letter(name) or _tabulated_letter(parents.get(name, "") if parents else "").lower()
+    return code or "N"
 
 
 @dataclass(frozen=True)
@@ -168,6 +175,9 @@ class AtomTable:
     occupancy : (n_atoms,) float64
     category : (n_atoms,) str
         One of :data:`ATOM_CATEGORIES`.
+    parents : dict of str to str
+        The standard parent of each modified residue by name, as the file records it (PDB
+        MODRES, mmCIF ``_pdbx_struct_mod_residue``): ``{'TCY': 'DA'}``.
     """
 
     entry_id: str
@@ -182,6 +192,7 @@ class AtomTable:
     b_factor: NDArray[np.float64]
     occupancy: NDArray[np.float64]
     category: NDArray[np.str_]
+    parents: Mapping[str, str] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return len(self.coords)

@@ -84,9 +84,10 @@ class SequenceStrip(QWidget):
         return len(document.structure.segments[document.segment]) if document.editable else 0
 
     def _loaded(self) -> None:
-        found = nucleotides(self.document.structure.atoms) if self.document.model is not None else None
+        atoms = self.document.structure.atoms if self.document.model is not None else None
+        found = nucleotides(atoms) if atoms is not None else None
         self._strands = [] if found is None else [
-            (str(found.chain[a]), "".join(nucleotide_letter(str(self.document.structure.atoms.resname[row]))
+            (str(found.chain[a]), "".join(nucleotide_letter(str(atoms.resname[row]), atoms.parents)
                                           for row in found.backbone[a:b]), found.colours[a:b])
             for a, b in zip(found.strand_start[:-1], found.strand_start[1:])]
         self._refresh()

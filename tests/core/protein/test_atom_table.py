@@ -58,6 +58,24 @@ def test_a_modified_nucleotide_of_a_dna_strand_is_a_nucleotide() -> None:
     assert strands == {"A": (0, ""), "B": (12, "DNA"), "C": (0, ""), "D": (12, "DNA")}
 
 
+@pytest.mark.parametrize("fmt", ["pdb", "mmcif"])
+def test_modified_residues_gemmi_does_not_know_take_their_parent_from_the_file(fmt: str, tmp_path: Path) -> None:
+    """PDB MODRES and mmCIF _pdbx_struct_mod_residue name the parent: 4OPJ's TCY is a dA,
+    1AM7's TRN a Trp (gemmi's residue table has neither)."""
+    paths = [DATA / "4OPJ.pdb.gz", DATA / "1AM7.pdb.gz"]
+    if fmt == "mmcif":
+        for k, path in enumerate(paths):
+            st = gemmi.read_structure(str(path))
+            st.setup_entities()
+            st.make_mmcif_document().write_file(str(tmp_path / f"{k}.cif"))
+            paths[k] = tmp_path / f"{k}.cif"
+    dna, lysozyme = read_structure(paths[0]), read_structure(paths[1])
+    assert dna.atoms.parents == {"TCY": "DA"} and lysozyme.atoms.parents == {"TRN": "TRP"}
+    for segment in lysozyme.segments:
+        trn = segment.resname == "TRN"
+        assert trn.sum() == 4 and set(np.array(list(segment.sequence))[trn]) == {"W"} and "X" not in segment.sequence
+
+
 def test_altlocs_are_recorded() -> None:
     atoms = read_structure(DATA / "1EJG.pdb.gz").atoms
     assert {"", "A", "B"} <= set(atoms.altloc.tolist())
