@@ -95,9 +95,14 @@ def secondary_structure(
 ) -> tuple[np.ndarray, str]:
     """'H'/'E'/'C' per backbone residue (concatenated runs) and where it came from."""
     rows = np.concatenate(runs)
-    if len(st.helices) or len(st.sheets):
-        ss = _ss_from_records(st, atoms, groups, notes)[rows]
-        return ss, SS_FROM_MMCIF if fmt == "mmcif" else SS_FROM_PDB_RECORDS
+    if len(st.helices) or any(len(sheet.strands) for sheet in st.sheets):
+        unmatched: list[str] = []
+        ss, matched = _ss_from_records(st, atoms, groups, unmatched)
+        if matched:
+            notes.extend(unmatched)
+            return ss[rows], SS_FROM_MMCIF if fmt == "mmcif" else SS_FROM_PDB_RECORDS
+        notes.append(f"none of the file's {len(unmatched)} helix and sheet records matches a residue of the "
+                     "model (renumbered after they were written?): secondary structure computed instead")
     res = groups.first[rows]
     xyz = _backbone_xyz(atoms, res)
     chain_start = np.zeros(len(rows), dtype=bool)
@@ -119,12 +124,14 @@ def secondary_structure(
 
 def _ss_from_records(
     st: gemmi.Structure, atoms: ScannedModel, groups: Groups, notes: list[str]
-) -> np.ndarray:
-    """'H'/'E'/'C' per residue group from the helix and sheet records (helix wins)."""
+) -> tuple[np.ndarray, int]:
+    """'H'/'E'/'C' per residue group from the helix and sheet records (helix wins), and how
+    many records matched the model; a note for each that did not."""
     res = groups.first
     where = {(atoms.chain[r], atoms.seq[r], atoms.icode[r]): g for g, r in enumerate(res.tolist())}
     chain = np.array([atoms.chain[r] for r in res], dtype=object)
     ss = np.full(len(res), "C", dtype="<U1")
+    matched = 0
     strands = [(s.start, s.end, "sheet strand") for sheet in st.sheets for s in sheet.strands]
     helices = [(h.start, h.end, "helix") for h in st.helices]
     for begin, end, what in strands + helices:
@@ -138,7 +145,8 @@ def _ss_from_records(
             continue
         span = np.arange(first, last + 1)
         ss[span[chain[span] == keys[0][0]]] = "H" if what == "helix" else "E"
-    return ss
+        matched += 1
+    return ss, matched
 
 
 def make_segments(

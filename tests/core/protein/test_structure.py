@@ -210,6 +210,39 @@ def test_secondary_structure_is_computed_without_records(tmp_path: Path) -> None
     assert (seg.ss[(seg.resseq >= 2) & (seg.resseq <= 7)] == "E").all()
 
 
+@pytest.mark.parametrize("fmt", ["pdb", "mmcif"])
+def test_records_that_match_no_residue_give_way_to_computed_secondary_structure(fmt: str, tmp_path: Path) -> None:
+    """Atoms renumbered after the HELIX/SHEET records were written (as pdb-tools' pdb_reres
+    does): the cartoon gets the computed assignment, not a chain of coil."""
+    st = gemmi.read_structure(str(DATA / "1UBQ.pdb.gz"))
+    renumbered = tmp_path / f"renumbered.{fmt}"
+    if fmt == "pdb":
+        for residue in st[0]["A"]:
+            residue.seqid = gemmi.SeqId(residue.seqid.num + 1000, " ")
+        st.write_pdb(str(renumbered))
+    else:  # the atoms' author numbers only: gemmi's writer would drop records it cannot place
+        document = st.make_mmcif_document()
+        numbers = document[0].find("_atom_site.", ["auth_seq_id"])
+        for row in numbers:
+            row[0] = str(int(row[0]) + 1000)
+        document.write_file(str(renumbered))
+    lines = text_of("1UBQ.pdb.gz").splitlines()
+    bare = tmp_path / "no_records.pdb"
+    bare.write_text("\n".join(ln for ln in lines if not ln.startswith(("HELIX", "SHEET"))) + "\n")
+    s = read_structure(renumbered)
+    assert s.ss_source == SS_COMPUTED
+    np.testing.assert_array_equal(s.segments[0].ss, read_structure(bare).segments[0].ss)
+    assert [w for w in s.warnings if "record" in w] == [
+        ("none of the file's 7 helix and sheet records matches a residue of the model (renumbered after they were "
+         "written?): secondary structure computed instead")]
+    one_off = tmp_path / "one_off.pdb"  # one record astray: the others still give the assignment
+    one_off.write_text("\n".join(ln.replace(" ILE A   23 ", " ILE A  923 ") if ln.startswith("HELIX") else ln
+                                  for ln in lines) + "\n")
+    s = read_structure(one_off)
+    assert s.ss_source == SS_FROM_PDB_RECORDS and (s.segments[0].ss == "E").sum() == 33
+    assert [w for w in s.warnings if "record" in w] == ["helix record A:923(ILE)-34(GLU) does not match the model: ignored"]
+
+
 def test_bad_inputs_raise_one_clear_error(tmp_path: Path) -> None:
     empty = tmp_path / "empty.pdb"
     empty.write_bytes(b"")
