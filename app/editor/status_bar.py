@@ -1,14 +1,17 @@
 """The window's status bar: the file, the edited chain, the level, the picked point (or the
-selection, or what a drag in the current mode does), the map's correlation and the name of
-what is under the pointer."""
+selection, or what a drag in the current mode does), the map's correlation, the name of
+what is under the pointer and, where reading the file skipped or ignored something, a button
+that says so."""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
 import numpy as np
-from PySide6.QtWidgets import QLabel, QStatusBar
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QLabel, QMessageBox, QStatusBar, QStyle, QToolButton
 
+from app import PROG
 from app.editor.interaction.drag import Mode
 
 if TYPE_CHECKING:
@@ -17,6 +20,8 @@ if TYPE_CHECKING:
     from app.editor.map_correlation import LiveCorrelation
 
 LABELS = ("file", "segment", "level", "pick", "map", "hover")
+NOTES_LISTED = 30
+"""Notes on reading listed in the dialog (and 10 in the tooltip); the rest are counted."""
 
 
 class StatusBar:
@@ -31,6 +36,14 @@ class StatusBar:
         self.labels = {key: QLabel() for key in LABELS}
         for key, label in self.labels.items():
             bar.addWidget(label, 1 if key == "pick" else 0)
+        self.notes = QToolButton()
+        self.notes.setAutoRaise(True)
+        self.notes.setIcon(bar.style().standardIcon(QStyle.StandardPixmap.SP_MessageBoxWarning))
+        self.notes.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+        self.notes.clicked.connect(self.show_notes)
+        bar.addPermanentWidget(self.notes)
+        document.fileChanged.connect(self._update_notes)
+        self._update_notes()
         for signal in (document.fileChanged, document.loaded, document.levelChanged, document.segmentChanged,
                        document.picked, document.selectionChanged):
             signal.connect(self.update)
@@ -64,6 +77,17 @@ class StatusBar:
             else f"point {pick.index} moves {len(pick.residues)} residues: {document.residue_range(pick.residues)}"
         )
 
+    def show_notes(self) -> None:
+        """A dialog listing what reading the file skipped or ignored (the button's click)."""
+        QMessageBox.information(self.notes.window(), PROG, f"Reading {self.document.path.name}:\n\n"
+                                + _listed(self.document.structure.warnings, NOTES_LISTED))
+
+    def _update_notes(self) -> None:
+        notes = self.document.structure.warnings if self.document.model is not None else ()
+        self.notes.setVisible(bool(notes))
+        self.notes.setText(f"{len(notes)} note{'' if len(notes) == 1 else 's'} on reading")
+        self.notes.setToolTip(_listed(notes, 10) + "\n\nClick for the list." if notes else "")
+
     def _update_correlation(self) -> None:
         value = self.correlation.value
         self.labels["map"].setText("" if value is None else f"map CC {value:.3f}")
@@ -80,3 +104,9 @@ def selection_text(document: Document, named: int = 4) -> str:
         return f"{first if first == last else f'{first}–{last}'} ({len(rows)} residues)"
     shown = ", ".join(label(int(row)) for row in rows[:named])
     return f"{len(rows)} residues: {shown}" + (f" … {label(int(rows[-1]))}" if len(rows) > named else "")
+
+
+def _listed(notes: tuple[str, ...], most: int) -> str:
+    """The first ``most`` of ``notes``, a line each, and how many more there are."""
+    shown = "\n".join(f"• {note}" for note in notes[:most])
+    return shown + (f"\n… and {len(notes) - most} more" if len(notes) > most else "")

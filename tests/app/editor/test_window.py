@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QMimeData, QPoint, QPointF, Qt, QUrl
 from PySide6.QtGui import QDropEvent, QImage
-from PySide6.QtWidgets import QApplication, QFileDialog
+from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
 from pytestqt.qtbot import QtBot
 
 from app import DEFAULT_STRUCTURE
@@ -592,6 +592,22 @@ def test_the_status_bar_follows_the_drag_mode(window: MainWindow, qtbot: QtBot) 
     assert window.status.labels["pick"].text().startswith("Drag the curve to tug it.")
     qtbot.keyClick(window, Qt.Key.Key_M)
     assert window.status.labels["pick"].text().startswith("Click a control point to pick it")
+
+
+def test_what_reading_skipped_is_a_click_away_in_the_status_bar(qtbot: QtBot, monkeypatch: pytest.MonkeyPatch) -> None:
+    """4HHB's B:ASP79 has no bonded neighbour and is in no segment: the status bar says a note
+    was made, its tooltip and a click say which; a file read without notes hides the button."""
+    window = _window(qtbot, DATA / "4HHB.pdb.gz")
+    notes = window.status.notes
+    assert notes.isVisible() and notes.text() == "1 note on reading"
+    note = "residue B:ASP79 has no bonded neighbour: not in any segment"
+    assert note in notes.toolTip()
+    shown: list[str] = []
+    monkeypatch.setattr(QMessageBox, "information", lambda parent, title, text: shown.append(text))
+    qtbot.mouseClick(notes, Qt.MouseButton.LeftButton)
+    assert shown == [f"Reading 4HHB.pdb.gz:\n\n• {note}"]
+    window.document.open(DATA / "1UBQ.pdb.gz")
+    assert not notes.isVisible()
 
 
 def test_choosing_another_chain_frames_it(qtbot: QtBot) -> None:
