@@ -17,7 +17,7 @@ from app.arguments import bounded, chain_hint, writable_output
 from app.errors import InputError
 from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
-from core.protein.structure import Structure
+from core.protein.structure import SS_COMPUTED, Structure
 from core.protein.writing import output_format
 
 MAX_MODEL = 100_000
@@ -129,8 +129,9 @@ def run_info(args: argparse.Namespace) -> int:
     if not report["segments"]:
         print("  no protein chain: no ribbon to decompose (the editor shows the entry)")
         return 0
+    source = report["secondary_structure_source"]
     print(f"  {report['residues']} backbone residues: {ss['H']} helix, {ss['E']} sheet, {ss['C']} other "
-          f"(from {report['secondary_structure_source']})")
+          f"({'computed by DSSP' if source == SS_COMPUTED else f'from {source}'})")
     print(f"  {'chain':<6}{'seg':>4}  {'residues':>8}  {'from':<14}{'to':<14}{'max level':>10}")
     for s in report["segments"]:
         print(f"  {s['chain']:<6}{s['segment']:>4}  {s['residues']:>8}  {s['first']:<14}{s['last']:<14}"

@@ -37,6 +37,8 @@ def test_info_json_describes_ubiquitin(capsys):
     assert (report["method"], report["resolution"]) == ("X-RAY DIFFRACTION", 1.8)
     (segment,) = report["segments"]
     assert segment["max_level_peptide"] == pytest.approx(math.log2(76), abs=1e-4)
+    status, out, _ = run(capsys, "info", DATA / "2O9S_A.pdb.gz")  # no HELIX/SHEET records
+    assert status == 0 and out.splitlines()[2].endswith(" other (computed by DSSP)")
 
 
 def test_info_text_lists_every_segment_of_a_broken_chain(capsys):
