@@ -191,12 +191,13 @@ def _residue_rows(segment: BackboneSegment, residues: np.ndarray) -> tuple[np.nd
 
 
 def _bound_ligands(structure: Structure) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Per segment, the atom rows of the ligand and ion groups bound to it and the residue
-    (within the segment) each rides with: the residue of the backbone atom nearest to the
-    group, when that atom lies within :data:`CARRY_DISTANCE` of one of the group's atoms."""
+    """Per segment, the atom rows of the ligand and ion groups (:attr:`Structure.ligand_rows`)
+    bound to it and the residue (within the segment) each rides with: the residue of the
+    backbone atom nearest to the group, when that atom lies within :data:`CARRY_DISTANCE` of
+    one of the group's atoms."""
     empty = np.empty(0, dtype=np.int64)
     bound: list[tuple[np.ndarray, np.ndarray]] = [(empty, empty)] * len(structure.segments)
-    ligand = np.flatnonzero(structure.atoms.category == "ligand")
+    ligand = structure.ligand_rows
     polymer = np.flatnonzero(structure.atom_residue >= 0)
     if not len(ligand) or not len(polymer):
         return bound

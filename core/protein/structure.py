@@ -270,6 +270,14 @@ class Structure:
         """Rows of the residue table (backbone residues of all segments)."""
         return sum(len(s) for s in self.segments)
 
+    @cached_property
+    def ligand_rows(self) -> NDArray[np.int64]:
+        """Rows of the atoms drawn and carried as ligands: every ``ligand`` atom, and the
+        atoms of protein residues no segment holds (GFP's chromophore CRO66, which has no Cα;
+        a residue with no bonded neighbour), which the ribbon would otherwise leave unseen."""
+        category = self.atoms.category
+        return np.flatnonzero((category == "ligand") | ((category == "protein") & (self.atom_residue < 0)))
+
     def residue_label(self, row: int) -> str:
         """The label of residue-table row ``row``, e.g. ``'A:LYS48'``."""
         segment, index = self.residue_place(row)

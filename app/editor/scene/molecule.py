@@ -123,9 +123,10 @@ def bonds(coords: np.ndarray, elements: np.ndarray, altloc: np.ndarray, atoms: n
 
 
 def ions_and_ligands(structure: Structure) -> tuple[np.ndarray, np.ndarray]:
-    """Rows of ion atoms (a non-polymer, non-water group of one heavy atom) and of other ligand atoms."""
+    """Rows of ion atoms (a non-polymer, non-water group of one heavy atom) and of other ligand
+    atoms (:attr:`~core.protein.structure.Structure.ligand_rows`)."""
     table = structure.atoms
-    ligand = np.flatnonzero(table.category == "ligand")
+    ligand = structure.ligand_rows
     heavy = ligand[np.char.upper(table.element[ligand].astype(str)) != "H"]
     groups, counts = np.unique(table.residue[heavy], return_counts=True)
     single = np.isin(table.residue[ligand], groups[counts == 1])

@@ -56,6 +56,11 @@ def test_ions_and_ligands() -> None:
     assert len(ligands) == 27 * 2  # two ADP molecules
     bonds = molecule.bonds(structure.coords, table.element, table.altloc, ligands)
     assert len(bonds) >= len(ligands) - 2  # each ADP is connected
+    haemoglobin = read_structure(DATA / "4HHB.pdb.gz")  # B:ASP79 is in no segment: drawn as a ligand is
+    _, ligands = molecule.ions_and_ligands(haemoglobin)
+    table = haemoglobin.atoms
+    names = {(str(table.chain[row]), str(table.resname[row]), int(table.resseq[row])) for row in ligands}
+    assert ("B", "ASP", 79) in names and {name for _, name, _ in names} == {"HEM", "ASP"}
 
 
 def test_colour_schemes(ubiquitin) -> None:

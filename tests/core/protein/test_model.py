@@ -1,5 +1,6 @@
 """Multiresolution editing of atoms on real structures: locality, rigidity, exact undo, save."""
 
+import gzip
 from pathlib import Path
 
 import numpy as np
@@ -192,8 +193,29 @@ def test_the_ligands_that_ride_are_those_within_4_angstroms(name: str) -> None:
     model = EditableModel(structure)
     riding = np.concatenate([model.bound_ligands(k)[0] for k in range(len(structure.segments))])
     atoms, polymer = structure.atoms, structure.coords[structure.atom_residue >= 0]
-    for group in np.unique(atoms.residue[atoms.category == "ligand"]):
+    for group in np.unique(atoms.residue[structure.ligand_rows]):
         rows = np.flatnonzero(atoms.residue == group)
         near = _distances(structure.coords[rows], polymer).min() <= 4.0
         assert np.isin(rows, riding).all() == near and (np.isin(rows, riding).any() == near), atoms.resname[rows[0]]
     assert len(riding) == len(np.unique(riding)) and not (atoms.category[riding] == "water").any()
+
+
+def test_a_residue_the_ribbon_skips_is_drawn_and_carried_as_a_ligand(tmp_path: Path) -> None:
+    """A protein residue no segment holds would be seen nowhere: one without a Cα (as GFP's
+    chromophore CRO66; here ubiquitin's Gln40 without its Cα) and 4HHB's B:ASP79, which has no
+    bonded neighbour, are among the ligand rows and ride with the residue nearest to them."""
+    lines = gzip.open(DATA / "1UBQ.pdb.gz", "rt").read().splitlines()
+    path = tmp_path / "no_ca.pdb"
+    path.write_text("\n".join(ln for ln in lines if not (ln.startswith("ATOM") and ln[12:16] == " CA "
+                                                       and ln[22:26] == "  40")) + "\n")
+    for structure, chain, number, hosts in ((read_structure(path), "A", 40, {"A:ILE36", "A:PRO38", "A:GLN41"}),
+                                            (read_structure(DATA / "4HHB.pdb.gz"), "B", 79, {"B:LEU78"})):
+        atoms = structure.atoms
+        skipped = np.flatnonzero((atoms.chain == chain) & (atoms.resseq == number))
+        assert len(skipped) and (structure.atom_residue[skipped] < 0).all()
+        assert np.isin(skipped, structure.ligand_rows).all() and set(atoms.category[skipped]) == {"protein"}
+        model = EditableModel(structure)
+        rides = [(k, host) for k in range(len(structure.segments))
+                 for row, host in zip(*model.bound_ligands(k), strict=True) if row in skipped]
+        assert len(rides) == len(skipped) and len({k for k, _ in rides}) == 1
+        assert {structure.segments[k].labels[host] for k, host in rides} <= hosts
