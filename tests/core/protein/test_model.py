@@ -204,7 +204,7 @@ def test_a_residue_the_ribbon_skips_is_drawn_and_carried_as_a_ligand(tmp_path: P
     """A protein residue no segment holds would be seen nowhere: one without a Cα (as GFP's
     chromophore CRO66; here ubiquitin's Gln40 without its Cα) and 4HHB's B:ASP79, which has no
     bonded neighbour, are among the ligand rows and ride with the residue nearest to them."""
-    lines = gzip.open(DATA / "1UBQ.pdb.gz", "rt").read().splitlines()
+    lines = gzip.decompress((DATA / "1UBQ.pdb.gz").read_bytes()).decode().splitlines()
     path = tmp_path / "no_ca.pdb"
     path.write_text("\n".join(ln for ln in lines if not (ln.startswith("ATOM") and ln[12:16] == " CA "
                                                        and ln[22:26] == "  40")) + "\n")
