@@ -2,9 +2,12 @@
 ``A:40-50``, lists of these (``A:40-42, B:45, 50``); as ChimeraX specifies them (``/A:45-50``,
 ``:45``, ``#1/A:45``, ``/A``, ``:his``, lists ``/A,B:40-42,50 /C:7``); and as PyMOL selects them
 (``chain A and resi 45-50``, ``resi 45``, ``c. A & i. 45``, ``resn HIS``, lists
-``chain A+B and resi 40-42+50``, ``/obj//A/45``, ``A/45/``, ``A/LYS`45/CA``); and the residues
-near others or a ligand, as both select a binding site (``byres resn HEM around 5``,
-``within 5 of A:45``; ``:HEM :<5``)."""
+``chain A+B and resi 40-42+50``, ``/obj//A/45``, ``A/45/``, ``A/LYS`45/CA``). Any of these
+combine with PyMOL's and ChimeraX's operators (:mod:`core.protein.selection`): ``and``,
+``or``, ``not``, parentheses, and the residues near others or a ligand, as both select a
+binding site (``byres resn HEM around 5``, ``within 5 of A:45``; ``:HEM :<5``); with classes
+of residues and groups (``ss H``, ``helix``, ``polymer``, ``organic``, ``solvent``, ...):
+``chain A and ss H``, ``/A:40-60 & :HIS``, ``byres organic around 4 and not resn HOH``."""
 
 from __future__ import annotations
 
@@ -15,6 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
+from core.protein.selection import OPERATORS, Operation, Term, parse, tokens
 from core.protein.structure import Structure
 
 _NUMBERS = r"(?P<first>-?\d+)(?P<icode>[A-Za-z]?)(?:\s*(?:-|–|\.\.)\s*(?P<last>-?\d+)(?P<last_icode>[A-Za-z]?))?"
@@ -27,17 +31,12 @@ _CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{_CHAIN}))?\s*(?::
 _PYMOL_RESI = re.compile(rf"(?:(?P<name>[A-Za-z]{{3}})`)?{_NUMBERS}")
 _PYMOL_WORDS = {"chain": "chain", "c.": "chain", "resi": "resi", "i.": "resi", "resn": "resn", "r.": "resn"}
 HELP = ("type e.g. A:45, 45, A:40-50 or A:40-42, B:45; ChimeraX /A:45-50,60, :45, :his or :HEM :<5; PyMOL "
-        "chain A and resi 45-50+60, resi 45, resn HIS, byres resn HEM around 5, /obj//A/45 or A/45/")
+        "chain A and resi 45-50+60, resi 45, resn HIS, byres resn HEM around 5, /obj//A/45 or A/45/; combined by "
+        "and, or, not and parentheses, with ss H, helix, polymer, organic or solvent")
 MAX_PARTS = 10_000
 """Most parts (a residue, range or chain each) a list may name."""
 MAX_REACH = 50.0
 """Å: the farthest a selection of the residues near others reaches."""
-_NUMBER = r"(?P<reach>\d+(?:\.\d*)?|\.\d+)"
-_NEAR = (re.compile(rf"(?:byres\s+)?\(?(?P<of>.+?)\)?\s+(?P<how>around|expand)\s+{_NUMBER}", re.IGNORECASE),  # PyMOL
-         re.compile(rf"(?:byres\s+)?within\s+{_NUMBER}\s+of\s+\(?(?P<of>.+?)\)?", re.IGNORECASE),
-         re.compile(rf"(?P<of>.+?)\s+[:@]<\s*{_NUMBER}"))  # ChimeraX's zone
-"""The residues near others: PyMOL's ``around`` (without them) and ``expand`` and ``within``
-(with them, where they are residues of the backbone), ChimeraX's zone (with them)."""
 
 
 @dataclass(frozen=True)
@@ -66,46 +65,142 @@ def find_residues(structure: Structure, text: str, chain: str | None = None, coo
     the residues of a name (``resn HIS``, ``:his``: in every chain where none is named) or a
     list of them (``A:40-42, B:45``, ``/A:40-42,50``, ``resi 40-42+50``), in any syntax of the
     module's; a part names ``chain`` when neither it nor a part before it in its list names one
-    (any chain when ``chain`` is None, the first that has it). Or the residues with an atom
-    within a distance of those or of a ligand's (``byres resn HEM around 5``), measured on
-    ``coords`` (every atom's, Å; default: as read). Raises ValueError naming what is missing or
-    how to type it."""
-    for pattern in _NEAR:
-        if near := pattern.fullmatch(text.strip()):
-            return _near(structure, near, chain, structure.coords if coords is None else coords)
+    (any chain when ``chain`` is None, the first that has it). Or these combined by operators
+    (``chain A and ss H``, ``resi 40-45 or resi 90``), among them the residues with an atom
+    within a distance of others or of a ligand (``byres resn HEM around 5``), measured on
+    ``coords`` (every atom's, Å; default: as read); in a combined selection a residue number
+    without a chain names that residue in every chain, as in PyMOL. Raises ValueError naming
+    what is missing or how to type it."""
+    coords = structure.coords if coords is None else coords
+    if not OPERATORS.isdisjoint(kind for kind, _ in tokens(text)):
+        return _selected(structure, text, coords)
     parts = _read_all(text.strip())
     if parts is None:
-        raise ValueError(f"cannot read {text.strip()!r} as residues: {HELP}")
+        return _selected(structure, text, coords)
     if len(parts) == 1:
         return _rows(structure, *parts[0], chain)
     return np.unique(np.concatenate([_rows(structure, part, named, chain) for part, named in parts]))
 
 
-def _near(structure: Structure, near: re.Match, chain: str | None, coords: np.ndarray) -> np.ndarray:
-    """The backbone residues with an atom within ``near``'s reach of the atoms it names: of a
-    residue name (a ligand's: ``resn HEM``, ``:HEM``, in a chain too) or of residues."""
-    reach = float(near["reach"])
-    if not 0.0 < reach <= MAX_REACH:
-        raise ValueError(f"a distance of {near['reach']} Å: give one above 0 and at most {MAX_REACH:g} Å")
-    atoms, of = structure.atoms, near["of"].strip()
-    named = _read(of)
-    if named is not None and named.first is None and named.name is not None:  # every group of a name
-        chosen = (atoms.resname == named.name.upper()) & ((atoms.chain == named.chain) if named.chain else True)
-        if not chosen.any():
-            raise ValueError(f"no residue or ligand {named.name.upper()}"
-                             + (f" in chain {named.chain}" if named.chain else ""))
-        rows = np.unique(structure.atom_residue[chosen & (structure.atom_residue >= 0)])
+def _selected(structure: Structure, text: str, coords: np.ndarray) -> np.ndarray:
+    """The backbone residues of a selection combined by operators (:mod:`core.protein.selection`),
+    its terms read in every chain where they name none."""
+    atoms = _atoms_of(structure, _merged(parse(text)), coords)
+    rows = np.unique(structure.atom_residue[atoms & (structure.atom_residue >= 0)])
+    if not len(rows):
+        raise ValueError(f"no residue of a protein backbone is in {text.strip()!r}")
+    return rows
+
+
+def _merged(tree: Term | Operation) -> Term | Operation:
+    """``tree`` with each ``and`` of terms that read as one (PyMOL's ``resn HEM and chain A``,
+    the hemes of chain A; ``chain B and resi 45``) made one term."""
+    if isinstance(tree, Term):
+        return tree
+    operands = tuple(_merged(operand) for operand in tree.operands)
+    if tree.kind == "and" and all(isinstance(operand, Term) for operand in operands):
+        joined = f"{operands[0].text} and {operands[1].text}"
+        if _read(joined) is not None:
+            return Term(joined)
+    return Operation(tree.kind, operands, tree.reach)
+
+
+def _atoms_of(structure: Structure, tree: Term | Operation, coords: np.ndarray) -> np.ndarray:
+    """(n_atoms,) bool: the atoms of the whole residues and groups ``tree`` selects."""
+    if isinstance(tree, Term):
+        chosen = _term_atoms(structure, tree.text)
     else:
-        rows = find_residues(structure, of, chain)
-        chosen = np.isin(structure.atom_residue, rows)
-    backbone = np.flatnonzero(structure.atom_residue >= 0)
-    close = cKDTree(coords[chosen]).query_ball_point(coords[backbone], reach, return_length=True) > 0
-    found = np.unique(structure.atom_residue[backbone[close]])
-    if (near.groupdict().get("how") or "").lower() == "around":
-        found = np.setdiff1d(found, rows)
-    if not len(found):
-        raise ValueError(f"no residue within {reach:g} Å of {of}")
-    return found
+        first = _atoms_of(structure, tree.operands[0], coords)
+        if tree.kind == "not":
+            chosen = ~first
+        elif tree.kind in ("and", "or"):
+            second = _atoms_of(structure, tree.operands[1], coords)
+            chosen = first & second if tree.kind == "and" else first | second
+        else:
+            if not 0.0 < tree.reach <= MAX_REACH:
+                raise ValueError(f"a distance of {tree.reach:g} Å: give one above 0 and at most {MAX_REACH:g} Å")
+            near = np.zeros(len(first), dtype=bool)
+            if first.any():
+                near = cKDTree(coords[first]).query_ball_point(coords, tree.reach, return_length=True) > 0
+            chosen = near & ~first if tree.kind == "around" else near | first
+    residue = structure.atoms.residue
+    return np.isin(residue, residue[chosen])  # whole residues and groups, as PyMOL's byres
+
+
+def _term_atoms(structure: Structure, text: str) -> np.ndarray:
+    """(n_atoms,) bool: the atoms ``text`` names, in every chain where it names none: a residue,
+    range, chain, name or list as :func:`find_residues` reads them, or a class of them."""
+    atoms, key = structure.atoms, text.strip().lower()
+    if key in _CLASSES:
+        return _CLASSES[key](structure)
+    if match := re.fullmatch(r"(?:ss|secondary)\s+(?P<codes>[a-z'+]+)", key):
+        codes = {_SS_CODES.get(code, "?") for code in match["codes"].replace("''", "l").split("+")}
+        if "?" in codes:
+            raise ValueError(f"{text.strip()!r}: secondary structure is H (helix), S (strand) or L (loop)")
+        return _residues_atoms(structure, np.concatenate([s.ss for s in structure.segments]) if structure.segments
+                               else np.empty(0, str), codes)
+    parts = _read_all(text.strip()) or ([(text.strip(), named)] if (named := _read(text.strip())) else None)
+    if parts is None:
+        raise ValueError(f"cannot read {text.strip()!r} as residues: {HELP}")
+    chosen = np.zeros(len(atoms), dtype=bool)
+    for part, named in parts:
+        if named.first is None:  # a chain, or every residue or group of a name
+            here = (atoms.chain == named.chain) if named.chain is not None else np.ones(len(atoms), dtype=bool)
+            if named.name is None and not here.any():
+                raise ValueError(f"no chain {named.chain} (chains: {', '.join(dict.fromkeys(atoms.chain.tolist()))})")
+            if named.name is not None:
+                here &= atoms.resname == named.name.upper()
+            if not here.any():
+                raise ValueError(f"no residue or ligand {named.name.upper()}"
+                                 + (f" in chain {named.chain}" if named.chain is not None else ""))
+            chosen |= here
+            continue
+        chains = [named.chain] if named.chain is not None else list(dict.fromkeys(s.chain for s in structure.segments))
+        found = []
+        for chain in chains:
+            try:
+                found.append(_rows(structure, part, replace(named, chain=chain), None))
+            except ValueError:
+                if named.chain is not None:
+                    raise
+        if not found:
+            raise ValueError(f"no residue {part.strip()} in any chain")
+        chosen |= np.isin(structure.atom_residue, np.concatenate(found))
+    return chosen
+
+
+def _residues_atoms(structure: Structure, values: np.ndarray, wanted: set[str]) -> np.ndarray:
+    """(n_atoms,) bool: the atoms of the backbone residues whose ``values`` (one per row) are ``wanted``."""
+    rows = np.flatnonzero(np.isin(values, sorted(wanted)))
+    return np.isin(structure.atom_residue, rows)
+
+
+def _ligand_groups(structure: Structure, carbon: bool) -> np.ndarray:
+    """(n_atoms,) bool: the ligand groups with (``carbon``) or without a carbon atom."""
+    atoms = structure.atoms
+    ligand = atoms.category == "ligand"
+    organic = np.isin(atoms.residue, atoms.residue[ligand & (atoms.element == "C")])
+    return ligand & (organic if carbon else ~organic)
+
+
+_SS_CODES = {"h": "H", "s": "E", "e": "E", "l": "C", "c": "C"}
+"""PyMOL's secondary-structure codes (H helix, S strand, L or '' loop) as the residue table's."""
+_CLASSES = {
+    "all": lambda structure: np.ones(structure.n_atoms, dtype=bool),
+    "*": lambda structure: np.ones(structure.n_atoms, dtype=bool),
+    "polymer": lambda structure: structure.atom_residue >= 0,
+    "protein": lambda structure: structure.atom_residue >= 0,
+    "organic": lambda structure: _ligand_groups(structure, carbon=True),
+    "ligand": lambda structure: _ligand_groups(structure, carbon=True),
+    "inorganic": lambda structure: _ligand_groups(structure, carbon=False),
+    "ions": lambda structure: _ligand_groups(structure, carbon=False),
+    "solvent": lambda structure: structure.atoms.category == "water",
+    "helix": lambda structure: _term_atoms(structure, "ss H"),
+    "strand": lambda structure: _term_atoms(structure, "ss S"),
+    "coil": lambda structure: _term_atoms(structure, "ss L"),
+}
+"""Classes of atoms by name, as PyMOL (``polymer``, ``organic``, ``inorganic``, ``solvent``) and
+ChimeraX (``protein``, ``ligand``, ``ions``, ``solvent``, ``helix``, ``strand``, ``coil``) name them."""
 
 
 def _rows(structure: Structure, text: str, named: _Named, chain: str | None) -> np.ndarray:

@@ -35,8 +35,9 @@ class Navigation:
         self.go_to_action = menus.action("&Go to Residue…", QKeySequence("Ctrl+L"), self._focus_go_to)
         self.go_to_action.setToolTip("Select residues and centre the view on them: A:45, 45, A:40-50, A:40-42, B:45; "
                                       "as in ChimeraX (/A:40-50, :45, /A, :his, :HEM :<5) or PyMOL (chain A and "
-                                      "resi 40-50+60, resi 45, A/45/, byres resn HEM around 5); a ligand (A:HEM) "
-                                      "to centre on it")
+                                      "resi 40-50+60, resi 45, A/45/, byres resn HEM around 5); combined by and, or, "
+                                      "not and parentheses, with ss H, helix, polymer, organic or solvent (chain A "
+                                      "and ss H, /A:40-60 & :HIS); a ligand (A:HEM) to centre on it")
         self.reset_view_action = menus.action("&Reset View", QKeySequence("Ctrl+R"), self._reset_view,
                                               window.style().standardIcon(QStyle.StandardPixmap.SP_BrowserReload))
         self.go_to_field = QLineEdit()

@@ -184,6 +184,25 @@ def test_go_to_a_binding_site_measures_the_atoms_where_they_are_now(open_window:
     assert "A:HIS87" not in [document.structure.residue_label(int(row)) for row in document.selection]
 
 
+def test_go_to_takes_selections_combined_as_pymol_and_chimerax_combine_them(open_window: Opener, qtbot: QtBot) -> None:
+    window = open_window("4HHB.pdb.gz")
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow)
+    field, document = window.navigation.go_to_field, window.document
+    for typed in ("chain B and ss H and not resn LEU", "/B & helix & ~:LEU"):
+        qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+        qtbot.keyClicks(field, typed)
+        qtbot.keyClick(field, Qt.Key.Key_Return)
+        expected = np.concatenate([s.residue_index[(s.ss == "H") & (s.resname != "LEU")]
+                                   for s in document.structure.segments if s.chain == "B"])  # (two: B:ASP79 is apart)
+        assert np.array_equal(document.selection, expected) and len(expected) > 50
+    qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
+    qtbot.keyClicks(field, "(chain A or chain B")
+    qtbot.keyClick(field, Qt.Key.Key_Return)
+    assert "expected a closing parenthesis at the end" in window.statusBar().currentMessage()
+    assert np.array_equal(document.selection, expected)  # a typing slip changes nothing
+
+
 def test_go_to_a_ligand_or_a_nucleotide_centres_on_it(open_window: Opener, qtbot: QtBot) -> None:
     window = open_window("4HHB.pdb.gz")
     atoms, coords = window.document.structure.atoms, window.document.model.coords

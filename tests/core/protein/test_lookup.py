@@ -104,7 +104,7 @@ def test_a_binding_site_is_measured_on_the_coordinates_given(haemoglobin) -> Non
     haem_a = (haemoglobin.atoms.resname == "HEM") & (haemoglobin.atoms.chain == "A")
     moved[haem_a] += 200.0  # far from every chain
     assert len(find_residues(haemoglobin, "resn HEM and chain A around 4")) == 16
-    with pytest.raises(ValueError, match="no residue within 4 Å of resn HEM and chain A"):
+    with pytest.raises(ValueError, match="no residue of a protein backbone is in 'resn HEM and chain A around 4'"):
         find_residues(haemoglobin, "resn HEM and chain A around 4", coords=moved)
 
 
@@ -131,7 +131,14 @@ def test_insertion_codes() -> None:
     ("A:87 around 99", "a distance of 99 Å: give one above 0 and at most 50 Å"),
     ("resn XYZ around 5", "no residue or ligand XYZ"),
     ("resn HEM and chain Q around 5", "no residue or ligand HEM in chain Q"), ("A:999 around 5", "no residue A:999"),
-    ("byres all", "cannot read 'byres all'"), ("chain A and chain B", "cannot read"), ("resn XYZ", "no residue XYZ"),
+    ("byres", "a selection is missing at the end"), ("chain A and chain B", "no residue of a protein backbone is in"),
+    ("resn XYZ", "no residue XYZ"), ("(chain A or chain B", "expected a closing parenthesis at the end"),
+    ("chain A and", "a selection is missing at the end"), ("chain A) or chain B", r"'\)' where an operator or the end"),
+    ("resi 40 around", "a distance in Å is missing"), ("resi 40 around five", "not 'five'"),
+    ("chain A and ss Q", "secondary structure is H"), ("resi 40 or resi 9999", "no residue resi 9999 in any chain"),
+    ("chain A or name CA", "cannot read 'name CA' as residues"), ("/A | /Q", r"no chain Q \(chains: A, B, C, D\)"),
+    ("within 5 of", "a selection is missing at the end"), ("(" * 5000 + "chain A" + ")" * 5000, "nested more than 100"),
+    ("not " * 5000 + "chain A", "nested more than 100"), ("chain A within 5 resn HEM", "expected of before 'resn'"),
     ("chain A and resn ILE", "no residue ILE in chain A"),
     ("#1", "cannot read"), ("/Z:5", "no chain Z"), ("chain B and resi 400", "no residue chain B and resi 400 in chain B"),
 ])
@@ -202,3 +209,67 @@ def test_a_file_that_names_no_chain_says_so() -> None:
     with pytest.raises(ValueError, match=r"no chain A with a protein backbone \(chains: none \(the file names no"):
         find_residues(adk, "chain A and resi 20-30")
     assert len(find_residues(adk, "resi 20-30")) == 11
+
+
+def _rows_where(structure, keep) -> np.ndarray:
+    """Brute force: the residue-table rows of the residues for which ``keep(segment, k)`` holds."""
+    return np.array([int(s.residue_index[k]) for s in structure.segments for k in range(len(s)) if keep(s, k)],
+                    dtype=np.int64)
+
+
+@pytest.mark.parametrize(("text", "keep"), [
+    ("chain A and ss H", lambda s, k: s.chain == "A" and s.ss[k] == "H"),
+    ("helix & /B", lambda s, k: s.chain == "B" and s.ss[k] == "H"),  # ChimeraX
+    ("ss L+S and chain C", lambda s, k: s.chain == "C" and s.ss[k] in "CE"),
+    ("resi 40-45 or resi 90", lambda s, k: 40 <= s.resseq[k] <= 45 or s.resseq[k] == 90),  # in every chain
+    ("not (chain A or chain B)", lambda s, k: s.chain in "CD"),
+    ("!chain A & !chain B", lambda s, k: s.chain in "CD"),
+    ("~/A & ~/B", lambda s, k: s.chain in "CD"),
+    ("/A:40-50 & :HIS", lambda s, k: s.chain == "A" and 40 <= s.resseq[k] <= 50 and s.resname[k] == "HIS"),
+    ("chain A and not resn HIS+LEU", lambda s, k: s.chain == "A" and s.resname[k] not in ("HIS", "LEU")),
+    ("not chain A and ss H", lambda s, k: s.chain != "A" and s.ss[k] == "H"),  # not binds tightest
+    ("resi 87 and chain A or resi 92 and chain B", lambda s, k: (s.chain, s.resseq[k]) in (("A", 87), ("B", 92))),
+    ("polymer and (chain C or chain D) and resi 10-20", lambda s, k: s.chain in "CD" and 10 <= s.resseq[k] <= 20),
+    ("all and not strand", lambda s, k: True),  # haemoglobin has no strand
+])
+def test_selections_combined_by_operators(haemoglobin, text: str, keep) -> None:
+    rows = find_residues(haemoglobin, text, "A")
+    assert np.array_equal(rows, _rows_where(haemoglobin, keep)) and len(rows) >= 2
+
+
+@pytest.mark.parametrize(("text", "reference", "chain", "reach"), [
+    ("byres organic around 5", "HEM", None, 5.0),  # PO4 is no organic group: it has no carbon
+    ("resn HEM and chain A around 4", "HEM", "A", 4.0),  # the distances bind last: chain A's haem
+    ("(resn HEM and chain A) around 4", "HEM", "A", 4.0),
+    (":HEM :<4.5 & /C", "HEM", "CC", 4.5),  # the zone, then the chain
+    ("chain B within 6 of solvent", "HOH", "BB", 6.0),
+])
+def test_binding_sites_combined_by_operators(haemoglobin, text: str, reference: str, chain, reach: float) -> None:
+    """Against brute force; a chain of two letters keeps the residues of that chain of the site
+    of every chain's reference (e.g. C's residues near any haem)."""
+    atoms = haemoglobin.atoms
+    near = (atoms.resname == reference) & ((atoms.chain == chain) if chain and len(chain) == 1 else True)
+    expected = _within(haemoglobin, np.flatnonzero(near), reach, haemoglobin.coords)
+    if "around" in text:
+        expected = np.setdiff1d(expected, np.unique(haemoglobin.atom_residue[near]))
+    if chain and len(chain) == 2:
+        expected = np.intersect1d(expected, _rows_where(haemoglobin, lambda s, k: s.chain == chain[0]))
+    assert len(expected) > 5 and np.array_equal(find_residues(haemoglobin, text), expected)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_operators_obey_the_laws_of_sets(haemoglobin, seed: int) -> None:
+    """For random ranges X and Y: X or Y, X and Y, not X, and De Morgan's laws, as numpy's set
+    operations on X's and Y's own rows give them."""
+    random = np.random.default_rng(seed)
+    x, y = (f"{random.choice(list('ABCD'))}:{a}-{a + random.integers(5, 60)}" for a in random.integers(1, 80, 2))
+    rows_x, rows_y, every = find_residues(haemoglobin, x), find_residues(haemoglobin, y), np.arange(573)
+    assert np.array_equal(find_residues(haemoglobin, f"{x} or {y}"), np.union1d(rows_x, rows_y))
+    assert np.array_equal(find_residues(haemoglobin, f"not {x}"), np.setdiff1d(every, rows_x))
+    assert np.array_equal(find_residues(haemoglobin, f"not ({x} or {y})"),
+                          find_residues(haemoglobin, f"not {x} and not {y}"))
+    both = np.intersect1d(rows_x, rows_y)
+    if len(both):
+        assert np.array_equal(find_residues(haemoglobin, f"{x} and {y}"), both)
+        assert np.array_equal(find_residues(haemoglobin, f"not ({x} and {y})"),
+                              find_residues(haemoglobin, f"not {x} or not {y}"))
