@@ -84,11 +84,14 @@ def find_residues(structure: Structure, text: str, chain: str | None = None, coo
 
 def _selected(structure: Structure, text: str, coords: np.ndarray) -> np.ndarray:
     """The backbone residues of a selection combined by operators (:mod:`core.protein.selection`),
-    its terms read in every chain where they name none."""
-    atoms = _atoms_of(structure, _merged(parse(text)), coords)
+    its terms read in every chain where they name none; a term that names nothing there is
+    empty, as in PyMOL (``(chain A or chain B) and resi 10-20`` of a one-chain protein)."""
+    missing: list[str] = []
+    atoms = _atoms_of(structure, _merged(parse(text)), coords, missing)
     rows = np.unique(structure.atom_residue[atoms & (structure.atom_residue >= 0)])
     if not len(rows):
-        raise ValueError(f"no residue of a protein backbone is in {text.strip()!r}")
+        raise ValueError(f"no residue of a protein backbone is in {text.strip()!r}"
+                         + (f" ({'; '.join(dict.fromkeys(missing))})" if missing else ""))
     return rows
 
 
@@ -105,16 +108,17 @@ def _merged(tree: Term | Operation) -> Term | Operation:
     return Operation(tree.kind, operands, tree.reach)
 
 
-def _atoms_of(structure: Structure, tree: Term | Operation, coords: np.ndarray) -> np.ndarray:
-    """(n_atoms,) bool: the atoms of the whole residues and groups ``tree`` selects."""
+def _atoms_of(structure: Structure, tree: Term | Operation, coords: np.ndarray, missing: list[str]) -> np.ndarray:
+    """(n_atoms,) bool: the atoms of the whole residues and groups ``tree`` selects; what its
+    terms name that the structure lacks is added to ``missing``."""
     if isinstance(tree, Term):
-        chosen = _term_atoms(structure, tree.text)
+        chosen = _term_atoms(structure, tree.text, missing)
     else:
-        first = _atoms_of(structure, tree.operands[0], coords)
+        first = _atoms_of(structure, tree.operands[0], coords, missing)
         if tree.kind == "not":
             chosen = ~first
         elif tree.kind in ("and", "or"):
-            second = _atoms_of(structure, tree.operands[1], coords)
+            second = _atoms_of(structure, tree.operands[1], coords, missing)
             chosen = first & second if tree.kind == "and" else first | second
         else:
             if not 0.0 < tree.reach <= MAX_REACH:
@@ -127,9 +131,11 @@ def _atoms_of(structure: Structure, tree: Term | Operation, coords: np.ndarray) 
     return np.isin(residue, residue[chosen])  # whole residues and groups, as PyMOL's byres
 
 
-def _term_atoms(structure: Structure, text: str) -> np.ndarray:
+def _term_atoms(structure: Structure, text: str, missing: list[str]) -> np.ndarray:
     """(n_atoms,) bool: the atoms ``text`` names, in every chain where it names none: a residue,
-    range, chain, name or list as :func:`find_residues` reads them, or a class of them."""
+    range, chain, name or list as :func:`find_residues` reads them, or a class of them. A part
+    the structure lacks selects nothing and is added to ``missing``; ValueError for a text
+    that is none of these."""
     atoms, key = structure.atoms, text.strip().lower()
     if key in _CLASSES:
         return _CLASSES[key](structure)
@@ -137,42 +143,57 @@ def _term_atoms(structure: Structure, text: str) -> np.ndarray:
         codes = {_SS_CODES.get(code, "?") for code in match["codes"].replace("''", "l").split("+")}
         if "?" in codes:
             raise ValueError(f"{text.strip()!r}: secondary structure is H (helix), S (strand) or L (loop)")
-        return _residues_atoms(structure, np.concatenate([s.ss for s in structure.segments]) if structure.segments
-                               else np.empty(0, str), codes)
+        return _ss_atoms(structure, codes)
     parts = _read_all(text.strip()) or ([(text.strip(), named)] if (named := _read(text.strip())) else None)
     if parts is None:
         raise ValueError(f"cannot read {text.strip()!r} as residues: {HELP}")
     chosen = np.zeros(len(atoms), dtype=bool)
     for part, named in parts:
-        if named.first is None:  # a chain, or every residue or group of a name
-            here = (atoms.chain == named.chain) if named.chain is not None else np.ones(len(atoms), dtype=bool)
-            if named.name is None and not here.any():
-                raise ValueError(f"no chain {named.chain} (chains: {', '.join(dict.fromkeys(atoms.chain.tolist()))})")
-            if named.name is not None:
-                here &= atoms.resname == named.name.upper()
-            if not here.any():
-                raise ValueError(f"no residue or ligand {named.name.upper()}"
-                                 + (f" in chain {named.chain}" if named.chain is not None else ""))
-            chosen |= here
-            continue
-        chains = [named.chain] if named.chain is not None else list(dict.fromkeys(s.chain for s in structure.segments))
-        found = []
-        for chain in chains:
-            try:
-                found.append(_rows(structure, part, replace(named, chain=chain), None))
-            except ValueError:
-                if named.chain is not None:
-                    raise
-        if not found:
-            raise ValueError(f"no residue {part.strip()} in any chain")
-        chosen |= np.isin(structure.atom_residue, np.concatenate(found))
+        try:
+            chosen |= _part_atoms(structure, part, named)
+        except ValueError as error:
+            missing.append(str(error))
     return chosen
 
 
-def _residues_atoms(structure: Structure, values: np.ndarray, wanted: set[str]) -> np.ndarray:
-    """(n_atoms,) bool: the atoms of the backbone residues whose ``values`` (one per row) are ``wanted``."""
-    rows = np.flatnonzero(np.isin(values, sorted(wanted)))
-    return np.isin(structure.atom_residue, rows)
+def _part_atoms(structure: Structure, part: str, named: _Named) -> np.ndarray:
+    """(n_atoms,) bool: the atoms of one part of a term (ValueError where it names nothing)."""
+    atoms = structure.atoms
+    if named.first is None:  # a chain, or every residue or group of a name
+        here = (atoms.chain == named.chain) if named.chain is not None else np.ones(len(atoms), dtype=bool)
+        if named.name is None and not here.any():
+            raise ValueError(f"no chain {named.chain}")
+        if named.name is not None:
+            here &= atoms.resname == named.name.upper()
+        if not here.any():
+            raise ValueError(f"no residue or ligand {named.name.upper()}"
+                             + (f" in chain {named.chain}" if named.chain is not None else ""))
+        return here
+    if named.last is not None and not named.icode and not named.last_icode:  # every number in the range, as PyMOL
+        low, high = sorted((named.first, named.last))
+        rows = np.concatenate([s.residue_index[(s.resseq >= low) & (s.resseq <= high)
+                                               & ((s.resname == named.name.upper()) if named.name else True)]
+                               for s in structure.segments if named.chain in (None, s.chain)] or [np.empty(0, int)])
+        if not len(rows):
+            raise ValueError(f"no residue {part.strip()}" + (f" in chain {named.chain}" if named.chain else " in any chain"))
+        return np.isin(structure.atom_residue, rows)
+    chains = [named.chain] if named.chain is not None else list(dict.fromkeys(s.chain for s in structure.segments))
+    found = []
+    for chain in chains:
+        try:
+            found.append(_rows(structure, part, replace(named, chain=chain), None))
+        except ValueError:
+            if named.chain is not None:
+                raise
+    if not found:
+        raise ValueError(f"no residue {part.strip()} in any chain")
+    return np.isin(structure.atom_residue, np.concatenate(found))
+
+
+def _ss_atoms(structure: Structure, codes: set[str]) -> np.ndarray:
+    """(n_atoms,) bool: the atoms of the backbone residues whose secondary structure is one of ``codes``."""
+    ss = np.concatenate([s.ss for s in structure.segments]) if structure.segments else np.empty(0, str)
+    return np.isin(structure.atom_residue, np.flatnonzero(np.isin(ss, sorted(codes))))
 
 
 def _ligand_groups(structure: Structure, carbon: bool) -> np.ndarray:
@@ -188,16 +209,16 @@ _SS_CODES = {"h": "H", "s": "E", "e": "E", "l": "C", "c": "C"}
 _CLASSES = {
     "all": lambda structure: np.ones(structure.n_atoms, dtype=bool),
     "*": lambda structure: np.ones(structure.n_atoms, dtype=bool),
-    "polymer": lambda structure: structure.atom_residue >= 0,
-    "protein": lambda structure: structure.atom_residue >= 0,
+    "polymer": lambda structure: np.isin(structure.atoms.category, ("protein", "nucleic")),
+    "protein": lambda structure: structure.atoms.category == "protein",
     "organic": lambda structure: _ligand_groups(structure, carbon=True),
     "ligand": lambda structure: _ligand_groups(structure, carbon=True),
     "inorganic": lambda structure: _ligand_groups(structure, carbon=False),
     "ions": lambda structure: _ligand_groups(structure, carbon=False),
     "solvent": lambda structure: structure.atoms.category == "water",
-    "helix": lambda structure: _term_atoms(structure, "ss H"),
-    "strand": lambda structure: _term_atoms(structure, "ss S"),
-    "coil": lambda structure: _term_atoms(structure, "ss L"),
+    "helix": lambda structure: _ss_atoms(structure, {"H"}),
+    "strand": lambda structure: _ss_atoms(structure, {"E"}),
+    "coil": lambda structure: _ss_atoms(structure, {"C"}),
 }
 """Classes of atoms by name, as PyMOL (``polymer``, ``organic``, ``inorganic``, ``solvent``) and
 ChimeraX (``protein``, ``ligand``, ``ions``, ``solvent``, ``helix``, ``strand``, ``coil``) name them."""

@@ -135,8 +135,8 @@ def test_insertion_codes() -> None:
     ("resn XYZ", "no residue XYZ"), ("(chain A or chain B", "expected a closing parenthesis at the end"),
     ("chain A and", "a selection is missing at the end"), ("chain A) or chain B", r"'\)' where an operator or the end"),
     ("resi 40 around", "a distance in Å is missing"), ("resi 40 around five", "not 'five'"),
-    ("chain A and ss Q", "secondary structure is H"), ("resi 40 or resi 9999", "no residue resi 9999 in any chain"),
-    ("chain A or name CA", "cannot read 'name CA' as residues"), ("/A | /Q", r"no chain Q \(chains: A, B, C, D\)"),
+    ("chain A and ss Q", "secondary structure is H"), ("resi 9998 or resi 9999", r"no residue of a protein backbone is in 'resi 9998 or resi 9999' \(no residue resi 9998 in any chain; no residue resi 9999 in any chain\)"),
+    ("chain A or name CA", "cannot read 'name CA' as residues"), ("/Q | /R", r"\(no chain Q; no chain R\)"),
     ("within 5 of", "a selection is missing at the end"), ("(" * 5000 + "chain A" + ")" * 5000, "nested more than 100"),
     ("not " * 5000 + "chain A", "nested more than 100"), ("chain A within 5 resn HEM", "expected of before 'resn'"),
     ("chain A and resn ILE", "no residue ILE in chain A"),
@@ -231,6 +231,8 @@ def _rows_where(structure, keep) -> np.ndarray:
     ("resi 87 and chain A or resi 92 and chain B", lambda s, k: (s.chain, s.resseq[k]) in (("A", 87), ("B", 92))),
     ("polymer and (chain C or chain D) and resi 10-20", lambda s, k: s.chain in "CD" and 10 <= s.resseq[k] <= 20),
     ("all and not strand", lambda s, k: True),  # haemoglobin has no strand
+    ("(chain A or chain Q) and resi 10-20 or resi 9999", lambda s, k: s.chain == "A" and 10 <= s.resseq[k] <= 20),
+    ("not (chain Q or resn XYZ)", lambda s, k: True),  # what is not there selects nothing, as in PyMOL
 ])
 def test_selections_combined_by_operators(haemoglobin, text: str, keep) -> None:
     rows = find_residues(haemoglobin, text, "A")
