@@ -15,6 +15,7 @@ import numpy as np
 
 from app.arguments import bounded, chain_hint, writable_output
 from app.errors import InputError
+from core.protein.assembly import assemblies
 from core.protein.input_files import StructureError
 from core.protein.reading import read_structure
 from core.protein.structure import SS_COMPUTED, Structure
@@ -105,8 +106,20 @@ def summary(structure: Structure) -> dict:
     }
 
 
+def biological_assemblies(path: Path, model: int) -> list[dict]:
+    """Number, name, chains, atoms and description of each biological assembly of the file
+    (none where it has no assembly records, or, with a warning, where one cannot be built)."""
+    try:
+        return [{"number": a.number, "name": a.name, "chains": a.chains, "atoms": a.atoms, "details": a.details}
+                for a in assemblies(path, model=model)]
+    except StructureError as error:
+        print(f"warning: {error}", file=sys.stderr)
+        return []
+
+
 def run_info(args: argparse.Namespace) -> int:
     report = summary(load(args.file, args.model, require_protein=False))
+    report["assemblies"] = biological_assemblies(args.file, args.model)
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
@@ -118,6 +131,11 @@ def run_info(args: argparse.Namespace) -> int:
     print(f"  {report['atoms']} atoms ({report['hetero_atoms']} hetero, {report['water_atoms']} water, "
           f"{report['altloc_atoms']} with altlocs); "
           + (f"model {report['model']} of {report['models']}" if report["models"] > 1 else "1 model"))
+    if report["assemblies"]:
+        listed = "; ".join(f"{a['number']}: {a['chains']} chain{'s' if a['chains'] != 1 else ''}, {a['atoms']:,} atoms"
+                           + (f" ({a['details'].lower()})" if a["details"] else "") for a in report["assemblies"][:4])
+        more = f"; ... ({len(report['assemblies'])} in all)" if len(report["assemblies"]) > 4 else ""
+        print(f"  biological assemblies (--assembly N): {listed}{more}")
     if report["ligands"]:
         print("  ligands and ions: " + ", ".join(f"{ligand['name']} ({ligand['count']})"
                                                  for ligand in report["ligands"]))

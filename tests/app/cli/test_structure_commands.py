@@ -59,6 +59,17 @@ def test_info_says_how_the_structure_was_determined(capsys):
     assert status == 0 and out.splitlines()[1].startswith("  76 atoms")
 
 
+def test_info_lists_the_biological_assemblies(capsys):
+    status, out, _ = run(capsys, "info", DATA / "4YVS.cif.gz")  # a capsid: 180 copies of its chains
+    assert status == 0 and "  biological assemblies (--assembly N): 1: 180 chains, 317,160 atoms (180-meric)" in out
+    status, out, _ = run(capsys, "info", DATA / "1TIM.pdb.gz", "--json")
+    (assembly,) = json.loads(out)["assemblies"]
+    structure = read_structure(DATA / "1TIM.pdb.gz")
+    assert (assembly["number"], assembly["chains"], assembly["atoms"]) == (1, 2, structure.n_atoms)  # the dimer as read
+    status, out, _ = run(capsys, "info", DATA / "2K39_CA-only.pdb.gz", "--json")  # no assembly records
+    assert status == 0 and json.loads(out)["assemblies"] == []
+
+
 def test_info_counts_the_ligands_and_ions_by_name(capsys):
     status, out, _ = run(capsys, "info", DATA / "4HHB.pdb.gz", "--json")
     assert status == 0 and json.loads(out)["ligands"] == [{"name": "HEM", "count": 4}, {"name": "PO4", "count": 2}]
