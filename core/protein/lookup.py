@@ -68,9 +68,10 @@ def find_residues(structure: Structure, text: str, chain: str | None = None, coo
     (any chain when ``chain`` is None, the first that has it). Or these combined by operators
     (``chain A and ss H``, ``resi 40-45 or resi 90``), among them the residues with an atom
     within a distance of others or of a ligand (``byres resn HEM around 5``), measured on
-    ``coords`` (every atom's, Å; default: as read); in a combined selection a residue number
-    without a chain names that residue in every chain, as in PyMOL. Raises ValueError naming
-    what is missing or how to type it."""
+    ``coords`` (every atom's, Å; default: as read); in a combined selection, as in PyMOL, a
+    residue number without a chain names that residue in every chain, a range every number in
+    it, and what the entry lacks selects nothing. Raises ValueError naming what is missing (of
+    a combined selection, where it selects no residue) or how to type it."""
     coords = structure.coords if coords is None else coords
     if not OPERATORS.isdisjoint(kind for kind, _ in tokens(text)):
         return _selected(structure, text, coords)
