@@ -134,3 +134,22 @@ def test_a_residue_clicked_with_the_label_tool_is_labelled(open_window: Opener) 
     label = document.structure.segments[0].labels[front]
     assert window.rw.measurements == [label] and _texts(window) == [label]
     assert window.measuring.wanted == 1  # still labelling
+
+
+def test_the_residues_of_a_binding_site_are_labelled_at_once(open_window: Opener, qtbot: QtBot) -> None:
+    """Go to Residue selects the haem pocket of chain A; *Label Selected Residues* labels each
+    of its residues at its Cα, in one change, and again only those not labelled yet."""
+    window = open_window("4HHB.pdb.gz")
+    action = window.measuring.label_selection_action
+    action.trigger()  # nothing selected: it says how to select
+    assert "Select residues first" in window.statusBar().currentMessage() and window.rw.measurements == []
+    pocket = window.rw.go_to("byres resn HEM and chain A around 4")
+    changes: list[int] = []
+    window.document.measurements.changed.connect(lambda: changes.append(1))
+    action.trigger()
+    assert window.rw.measurements == pocket and sorted(_texts(window)) == sorted(pocket) and changes == [1]
+    assert window.measurements_panel.table.rowCount() == len(pocket) == 16
+    window.rw.go_to("A:85-89")  # two of them are in the pocket already
+    action.trigger()
+    added = window.rw.measurements[len(pocket):]
+    assert added == [label for label in window.rw.selection if label not in pocket] and len(added) == 3
