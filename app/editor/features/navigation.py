@@ -21,7 +21,9 @@ if TYPE_CHECKING:
 
 
 FLAG_MARGIN = 4.0
-"""Å around a flag's atoms kept in view when it is shown."""
+"""Å around the atoms of a flag, or of what Go to Residue names, kept in view."""
+GO_TO_SHARE = 0.8
+"""Of the view's height that what Go to Residue names fills, at most (a flag fills a third)."""
 
 
 class Navigation:
@@ -85,7 +87,8 @@ class Navigation:
         chain, ``A:40-50``, ``A:40-42, B:45``, or as ChimeraX and PyMOL name them, a binding site
         too, measured as the atoms are now: :mod:`core.protein.lookup`), or centre on the
         ligand, ion, water or nucleotide it names (``A:HEM``, ``/B:20``), selecting nothing;
-        returns the residue-table rows selected (raises ValueError)."""
+        zoom in (never out) until their atoms fill most of the view. Returns the residue-table
+        rows selected (raises ValueError)."""
         if self.document.model is None:
             raise ValueError("no structure is open")
         structure, coords = self.document.structure, self.document.model.coords
@@ -97,11 +100,19 @@ class Navigation:
             if group is None:
                 raise
             self.document.select([])
-            self.scene.centre_on(coords[group].mean(axis=0))
-            self.plotter.render()
+            self._frame(coords[group].mean(axis=0), coords[group])
             return np.empty(0, dtype=np.int64)
-        self.select_and_centre(rows)
+        self.select(rows)
+        self._frame(coords[self.document.ca_rows[rows]].mean(axis=0), coords[np.isin(structure.atom_residue, rows)])
         return rows
+
+    def _frame(self, centre: np.ndarray, atoms: np.ndarray) -> None:
+        """Centre the view on ``centre`` (Å) and zoom in until ``atoms`` and a margin fill
+        :data:`GO_TO_SHARE` of its height (never out), as PyMOL's ``zoom`` and ChimeraX's
+        ``view`` do."""
+        self.scene.centre_on(centre)
+        self.scene.zoom_to(float(np.linalg.norm(atoms - centre, axis=1).max()) + FLAG_MARGIN, GO_TO_SHARE)
+        self.plotter.render()
 
     def _go_to_typed(self) -> None:
         try:

@@ -208,11 +208,11 @@ class Scene(QObject):
         low, high = ca.min(axis=0) - 2.0, ca.max(axis=0) + 2.0
         self.plotter.renderer.ResetCamera(low[0], high[0], low[1], high[1], low[2], high[2])
 
-    def zoom_to(self, reach: float) -> None:
+    def zoom_to(self, reach: float, share: float = 1.0 / 3.0) -> None:
         """Bring the camera closer to the centre of the view until ``reach`` Å around it fills
-        about a third of the view's height (never further away)."""
+        ``share`` of the view's height (never further away)."""
         camera = self.plotter.renderer.GetActiveCamera()
-        wanted = 3.0 * reach / np.tan(np.radians(camera.GetViewAngle()) / 2.0)
+        wanted = reach / share / np.tan(np.radians(camera.GetViewAngle()) / 2.0)
         if wanted < camera.GetDistance():  # the camera moves along its direction; the focal point stays
             focal = np.array(camera.GetFocalPoint())
             camera.SetPosition(*(focal - wanted * np.array(camera.GetDirectionOfProjection())))

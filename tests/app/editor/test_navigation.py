@@ -203,6 +203,24 @@ def test_go_to_takes_selections_combined_as_pymol_and_chimerax_combine_them(open
     assert np.array_equal(document.selection, expected)  # a typing slip changes nothing
 
 
+def test_go_to_zooms_in_on_what_it_names_and_never_out(open_window: Opener) -> None:
+    """The haem pocket of chain A is brought close enough to fill most of the view, every atom
+    of it inside the view; naming a whole chain afterwards centres on it without moving back."""
+    window = open_window("4HHB.pdb.gz")
+    camera, document = window.plotter.camera, window.document
+    far = camera.distance
+    rows = window.navigation.go_to("byres resn HEM and chain A around 4")
+    pocket = document.model.coords[np.isin(document.structure.atom_residue, rows)]
+    assert camera.distance < 0.6 * far
+    width, height = window.plotter.width(), window.plotter.height()
+    points = [_widget_point(window, atom) for atom in pocket]
+    assert all(0 <= p.x() < width and 0 <= p.y() < height for p in points)
+    assert max(p.y() for p in points) - min(p.y() for p in points) > 0.4 * height  # most of the view
+    near = camera.distance
+    window.navigation.go_to("chain A")
+    assert camera.distance == pytest.approx(near)
+
+
 def test_go_to_a_ligand_or_a_nucleotide_centres_on_it(open_window: Opener, qtbot: QtBot) -> None:
     window = open_window("4HHB.pdb.gz")
     atoms, coords = window.document.structure.atoms, window.document.model.coords

@@ -1,12 +1,13 @@
 """Labels and measurements in the view (:mod:`app.editor.measurements`): a line through each
-measurement's atoms (``measure_lines``) and its value, or a label's atom name, as text that
-faces the camera beside it; rewritten in place when an edit moves their atoms."""
+measurement's atoms (``measure_lines``) and its value, or a label's atom name, as text beside
+it drawn over the molecule (as ChimeraX draws labels: a label inside a pocket is read through
+the cartoon); rewritten in place when an edit moves their atoms."""
 
 from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
-from vtkmodules.vtkRenderingCore import vtkBillboardTextActor3D
+from vtkmodules.vtkRenderingCore import vtkTextActor
 
 from app.editor.document import Change
 from app.editor.measurements import Measurement
@@ -18,6 +19,8 @@ COLOUR = (20, 110, 150)
 TEXT_PIXELS = 15
 LABEL_OFFSET = 0.6
 """Å a label's text stands off its atom."""
+BACKING_OPACITY = 0.7
+"""Of the white box behind each text."""
 
 
 class MeasurementsLayer(SceneLayer):
@@ -30,7 +33,7 @@ class MeasurementsLayer(SceneLayer):
 
     def __init__(self, scene: Stage) -> None:
         super().__init__(scene)
-        self._texts: list[vtkBillboardTextActor3D] = []
+        self._texts: list[vtkTextActor] = []
         self._rows = np.empty(0, dtype=np.int64)
         self.document.measurements.changed.connect(self._changed)
 
@@ -44,12 +47,16 @@ class MeasurementsLayer(SceneLayer):
         self.add("measure_lines", color=COLOUR, line_width=3.0, render_lines_as_tubes=True)
         self._texts = []
         for k, measurement in enumerate(items):
-            text = vtkBillboardTextActor3D()
+            text = vtkTextActor()
+            text.GetPositionCoordinate().SetCoordinateSystemToWorld()
             style = text.GetTextProperty()
             style.SetFontSize(TEXT_PIXELS)
             style.SetBold(True)
             style.SetColor(*(c / 255 for c in COLOUR))
             style.SetJustificationToCentered()
+            style.SetVerticalJustificationToCentered()
+            style.SetBackgroundColor(1.0, 1.0, 1.0)  # legible on the cartoon's colours too
+            style.SetBackgroundOpacity(BACKING_OPACITY)
             self._texts.append(text)
             self.actors[f"measure_text_{k}"] = text
             self.scene.plotter.add_actor(text, name=f"measure_text_{k}", reset_camera=False, render=False,
@@ -69,7 +76,7 @@ class MeasurementsLayer(SceneLayer):
         for text in self._texts:
             text.SetVisibility(visible)
 
-    def _place(self, text: vtkBillboardTextActor3D, measurement: Measurement, coords: np.ndarray) -> None:
+    def _place(self, text: vtkTextActor, measurement: Measurement, coords: np.ndarray) -> None:
         """Put ``measurement``'s text where it belongs: beside a label's atom, at the middle of
         a distance, at an angle's vertex, at the middle of a dihedral's axis."""
         xyz = coords[list(measurement.atoms)]
@@ -79,7 +86,7 @@ class MeasurementsLayer(SceneLayer):
             where = xyz[1]
         else:  # the middle of a distance, of a dihedral's axis
             where = xyz[len(xyz) // 2 - 1:len(xyz) // 2 + 1].mean(axis=0)
-        text.SetPosition(*where)
+        text.GetPositionCoordinate().SetValue(*map(float, where))
         text.SetInput(measurement.text(self.document.structure, coords))
 
     def _changed(self) -> None:
