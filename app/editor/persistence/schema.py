@@ -26,7 +26,7 @@ MAX_ITEMS = 100_000
 MAX_INDEX = 2**31 - 1
 MAX_COORDINATE = 1e6
 """Å: the largest camera coordinate taken (structures use PDB's own limit, 1e4 Å)."""
-COLOURINGS = ("secondary structure", "residue type", "chain")
+COLOURINGS = ("secondary structure", "residue type", "chain", "rainbow, N to C", "B-factor")
 """The tube's colourings (:class:`app.editor.scene.molecule.Colouring`)."""
 
 _REQUIRED = object()

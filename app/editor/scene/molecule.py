@@ -12,7 +12,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from app.editor.scene.looks import RGB, SS_COLOURS
-from core.protein.structure import Structure
+from core.protein.structure import Structure, ca_rows
 
 
 class Colouring(StrEnum):
@@ -21,6 +21,8 @@ class Colouring(StrEnum):
     SECONDARY_STRUCTURE = "secondary structure"
     RESIDUE_TYPE = "residue type"
     CHAIN = "chain"
+    RAINBOW = "rainbow, N to C"
+    B_FACTOR = "B-factor"
 
 
 SS_NAMES = {"H": "helix", "E": "sheet", "C": "other"}
@@ -71,6 +73,17 @@ def residue_colours(structure: Structure, colouring: Colouring | str) -> np.ndar
         by_name = {name: rgb for rgb, names in RESIDUE_CLASSES.values() for name in names}
         names = np.concatenate([s.resname for s in segments])
         return np.array([by_name.get(n, OTHER_RESIDUE) for n in names], dtype=np.uint8).reshape(-1, 3)
+    if colouring is Colouring.RAINBOW:  # along each chain, as PyMOL's and ChimeraX's rainbow
+        chain = np.concatenate([np.full(len(s), s.chain, dtype=object) for s in segments])
+        along = np.zeros(len(chain))
+        for name in dict.fromkeys(chain.tolist()):
+            rows = np.flatnonzero(chain == name)
+            along[rows] = np.arange(len(rows)) / max(len(rows) - 1, 1)
+        return rainbow(along)
+    if colouring is Colouring.B_FACTOR:  # each residue's Cα, blue (lowest) to white to red (highest)
+        b = structure.atoms.b_factor[ca_rows(structure)]
+        low, high = _b_range(structure)
+        return blue_white_red((b - low) / (high - low) if high > low else np.full(len(b), 0.5))
     order = {name: k for k, name in enumerate(dict.fromkeys(s.chain for s in segments))}
     colours = [CHAIN_PALETTE[order[s.chain] % len(CHAIN_PALETTE)] for s in segments for _ in range(len(s))]
     return np.array(colours, dtype=np.uint8).reshape(-1, 3)
@@ -83,8 +96,45 @@ def legend(structure: Structure, colouring: Colouring | str) -> list[tuple[str, 
         return [(SS_NAMES[k], rgb) for k, rgb in SS_COLOURS.items()]
     if colouring is Colouring.RESIDUE_TYPE:
         return [(name, rgb) for name, (rgb, _) in RESIDUE_CLASSES.items()]
+    if colouring is Colouring.RAINBOW:
+        return [("N-terminus", _rgb(rainbow(np.zeros(1)))), ("C-terminus", _rgb(rainbow(np.ones(1))))]
+    if colouring is Colouring.B_FACTOR:
+        low, high = _b_range(structure)
+        if high <= low:
+            return [(f"B {low:.0f} Å² (every Cα)", _rgb(blue_white_red(np.full(1, 0.5))))]
+        return [(f"B {value:.0f} Å²", _rgb(blue_white_red(np.full(1, share))))
+                for value, share in ((low, 0.0), ((low + high) / 2, 0.5), (high, 1.0))]
     chains = dict.fromkeys(s.chain for s in structure.segments)
     return [(f"chain {c}", CHAIN_PALETTE[k % len(CHAIN_PALETTE)]) for k, c in enumerate(chains)]
+
+
+def rainbow(along: np.ndarray) -> np.ndarray:
+    """(n, 3) uint8: blue at 0, through cyan, green and yellow, to red at 1 (hue 240° to 0°)."""
+    hue = (1.0 - np.clip(along, 0.0, 1.0)) * 4.0  # in sixths of the circle: 0 red, 1 yellow, 2 green, 4 blue
+    red = np.clip(2.0 - hue, 0.0, 1.0)
+    green = np.minimum(np.clip(hue, 0.0, 1.0), np.clip(4.0 - hue, 0.0, 1.0))
+    blue = np.clip(hue - 2.0, 0.0, 1.0)
+    return np.round(np.stack([red, green, blue], axis=1) * 255).astype(np.uint8)
+
+
+def blue_white_red(share: np.ndarray) -> np.ndarray:
+    """(n, 3) uint8: blue at 0, white at 0.5, red at 1 (PyMOL's blue_white_red)."""
+    share = np.clip(share, 0.0, 1.0)[:, None]
+    blue, white, red = np.array([0.0, 0.0, 255.0]), np.array([255.0, 255.0, 255.0]), np.array([255.0, 0.0, 0.0])
+    rgb = np.where(share < 0.5, blue + (white - blue) * share * 2.0, white + (red - white) * (share - 0.5) * 2.0)
+    return np.round(rgb).astype(np.uint8)
+
+
+def _rgb(colours: np.ndarray) -> RGB:
+    """The first of ``colours`` (n, 3) as three ints."""
+    red, green, blue = (int(c) for c in colours[0])
+    return red, green, blue
+
+
+def _b_range(structure: Structure) -> tuple[float, float]:
+    """The lowest and highest B-factor of the backbone's Cα (Å²)."""
+    b = structure.atoms.b_factor[ca_rows(structure)]
+    return (float(b.min()), float(b.max())) if len(b) else (0.0, 0.0)
 
 
 def element_colours(elements: np.ndarray, carbon: RGB | None = None) -> np.ndarray:

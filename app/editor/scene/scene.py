@@ -126,7 +126,8 @@ class Scene(QObject):
         self.plotter.render()
 
     def set_colouring(self, colouring: Colouring | str) -> None:
-        """Colour the tube and the Cα trace by secondary structure, residue type or chain."""
+        """Colour the ribbons and the Cα trace by secondary structure, residue type, chain, a
+        rainbow along each chain or the Cα's B-factor (:class:`~app.editor.scene.molecule.Colouring`)."""
         self.colouring = Colouring(colouring)
         if self.document.editable:
             self._recolour()

@@ -145,7 +145,7 @@ CORPUS = {  # field missing, of another type, an unknown enum value, NaN or wron
     "clean past the steps": _set("index", "clean", 99),
     "level NaN": _set("index", "level", float("nan")),
     "multiresolution as text": _set("index", "multiresolution", "yes"),
-    "unknown colouring": _set("view", "colouring", "rainbow"),
+    "unknown colouring": _set("view", "colouring", "plaid"),
     "camera of two points": _set("view", "camera", [[0, 0, 1], [0, 0, 0]]),
     "camera with NaN": _set("view", "camera", [[float("nan")] * 3, [0, 0, 0], [0, 1, 0]]),
     "camera on its focal point": _set("view", "camera", [[1, 2, 3], [1, 2, 3], [0, 1, 0]]),

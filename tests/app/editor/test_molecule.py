@@ -8,6 +8,7 @@ import pytest
 from app.editor.scene import molecule
 from app.editor.scene.molecule import Colouring
 from core.protein.reading import read_structure
+from core.protein.structure import ca_rows
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 
@@ -76,3 +77,38 @@ def test_colour_schemes(ubiquitin) -> None:
     assert len({tuple(c) for c in chains}) == 4
     assert [name for name, _ in molecule.legend(haemoglobin, Colouring.CHAIN)] == [f"chain {c}" for c in "ABCD"]
     assert [name for name, _ in molecule.legend(ubiquitin, Colouring.SECONDARY_STRUCTURE)] == ["helix", "sheet", "other"]
+
+
+def _hue(rgb: np.ndarray) -> np.ndarray:
+    """Degrees of hue of (n, 3) colours."""
+    red, green, blue = (rgb.astype(float) / 255).T
+    return np.degrees(np.arctan2(np.sqrt(3) * (green - blue), 2 * red - green - blue)) % 360
+
+
+def test_rainbow_runs_from_blue_to_red_along_each_chain() -> None:
+    """As PyMOL's spectrum and ChimeraX's rainbow: each chain of 4HHB (chain B in two segments:
+    its Asp79 is apart) from blue at its first residue to red at its last, the hue falling all the way."""
+    haemoglobin = read_structure(DATA / "4HHB.pdb.gz")
+    colours = molecule.residue_colours(haemoglobin, Colouring.RAINBOW)
+    chain = np.concatenate([[s.chain] * len(s) for s in haemoglobin.segments])
+    for name in "ABCD":
+        rows = np.flatnonzero(chain == name)
+        assert tuple(colours[rows[0]]) == (0, 0, 255) and tuple(colours[rows[-1]]) == (255, 0, 0)
+        assert np.all(np.diff(_hue(colours[rows])) <= 1e-9)
+    assert [name for name, _ in molecule.legend(haemoglobin, Colouring.RAINBOW)] == ["N-terminus", "C-terminus"]
+
+
+def test_b_factor_colours_each_residue_by_its_calpha(ubiquitin) -> None:
+    """Blue at the lowest Cα B-factor, white halfway, red at the highest; redder with B (the
+    red share rises, the blue falls); one B for every Cα (an entry without them): all white."""
+    colours = molecule.residue_colours(ubiquitin, Colouring.B_FACTOR).astype(int)
+    b = ubiquitin.atoms.b_factor[ca_rows(ubiquitin)]
+    assert tuple(colours[np.argmin(b)]) == (0, 0, 255) and tuple(colours[np.argmax(b)]) == (255, 0, 0)
+    order = np.argsort(b, kind="stable")
+    assert np.all(np.diff(colours[order, 0] - colours[order, 2]) >= 0)
+    legend = molecule.legend(ubiquitin, Colouring.B_FACTOR)
+    assert [name for name, _ in legend] == [f"B {b.min():.0f} Å²", f"B {(b.min() + b.max()) / 2:.0f} Å²",
+                                            f"B {b.max():.0f} Å²"]
+    flat = read_structure(DATA / "1TIM.pdb.gz")  # every B-factor 0
+    assert np.all(molecule.residue_colours(flat, Colouring.B_FACTOR) == 255)
+    assert molecule.legend(flat, Colouring.B_FACTOR) == [("B 0 Å² (every Cα)", (255, 255, 255))]

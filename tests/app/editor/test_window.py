@@ -187,6 +187,11 @@ def test_layers_colours_and_fat_helices(window: MainWindow) -> None:
     colours = window.scene.meshes["cartoon"].point_data["colours"]
     assert tuple(colours[0]) == molecule.RESIDUE_CLASSES["hydrophobic"][0]  # Met1
     assert panel.legend_layout.rowCount() == len(molecule.RESIDUE_CLASSES)
+    panel.colouring.setCurrentIndex(panel.colouring.findData(Colouring.RAINBOW))  # Met1 blue
+    assert tuple(window.scene.meshes["cartoon"].point_data["colours"][0]) == (0, 0, 255)
+    panel.colouring.setCurrentIndex(panel.colouring.findData(Colouring.B_FACTOR))
+    assert panel.legend_layout.rowCount() == 3  # lowest, halfway, highest
+    panel.colouring.setCurrentIndex(panel.colouring.findData(Colouring.RESIDUE_TYPE))
     panel.layer_boxes[Layer.TUBE].setChecked(True)  # swept and coloured as it is shown again
     tube = window.scene.meshes["tube"]
     assert tuple(tube.point_data["colours"][0]) == molecule.RESIDUE_CLASSES["hydrophobic"][0]
