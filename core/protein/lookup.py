@@ -103,7 +103,7 @@ def _merged(tree: Term | Operation) -> Term | Operation:
         return tree
     operands = tuple(_merged(operand) for operand in tree.operands)
     if tree.kind == "and" and all(isinstance(operand, Term) for operand in operands):
-        joined = f"{operands[0].text} and {operands[1].text}"
+        joined = " and ".join(operand.text for operand in operands)
         if _read(joined) is not None:
             return Term(joined)
     return Operation(tree.kind, operands, tree.reach)
@@ -119,8 +119,9 @@ def _atoms_of(structure: Structure, tree: Term | Operation, coords: np.ndarray, 
         if tree.kind == "not":
             chosen = ~first
         elif tree.kind in ("and", "or"):
-            second = _atoms_of(structure, tree.operands[1], coords, missing)
-            chosen = first & second if tree.kind == "and" else first | second
+            chosen, combine = first, np.logical_and if tree.kind == "and" else np.logical_or
+            for operand in tree.operands[1:]:
+                combine(chosen, _atoms_of(structure, operand, coords, missing), out=chosen)
         else:
             if not 0.0 < tree.reach <= MAX_REACH:
                 raise ValueError(f"a distance of {tree.reach:g} Å: give one above 0 and at most {MAX_REACH:g} Å")

@@ -21,6 +21,8 @@ _BINDING = {"and": 6, "or": 4, "around": 3, "expand": 3, "zone": 3, "within": 3}
 """How tightly each operator after a selection binds (PyMOL's priorities; ``not`` 7, ``byres`` 2)."""
 MAX_DEPTH = 100
 """Most operators and parentheses nested in one another."""
+MAX_OPERATORS = 1000
+"""Most operators one selection may hold."""
 OPERATORS = frozenset({"or", "not", "byres", "around", "expand", "within", "zone", "open"})
 """Operators other than ``and`` (which a list of PyMOL's property selectors holds already)."""
 
@@ -34,8 +36,9 @@ class Term:
 
 @dataclass(frozen=True)
 class Operation:
-    """``kind`` (``and``, ``or``, ``not``, ``around``, ``expand``, ``within``) of ``operands``,
-    at ``reach`` Å for the distances (``within`` holds the operand and what is near it)."""
+    """``kind`` (``and``, ``or``, ``not``, ``around``, ``expand``, ``within``) of ``operands``
+    (two or more for ``and`` and ``or``, one for the others), at ``reach`` Å for the distances
+    (``within`` holds the operand and what is near it)."""
 
     kind: str
     operands: tuple[Term | Operation, ...]
@@ -59,7 +62,10 @@ def tokens(text: str) -> list[tuple[str, str]]:
 
 def parse(text: str) -> Term | Operation:
     """The tree of ``text``; ValueError where its operators do not combine."""
-    parser = _Parser(tokens(text), text)
+    found = tokens(text)
+    if sum(kind not in ("word", "open", "close", "of") for kind, _ in found) > MAX_OPERATORS:
+        raise _Parser(found, text).error(f"more than {MAX_OPERATORS:,} operators")
+    parser = _Parser(found, text)
     tree = parser.expression()
     if parser.position < len(parser.tokens):
         raise parser.error(f"{parser.tokens[parser.position][1]!r} where an operator or the end was expected")
@@ -85,24 +91,33 @@ class _Parser:
         return self.tokens[self.position - 1][1]
 
     def expression(self, binding: int = 0) -> Term | Operation:
-        """The selection from here whose operators bind at least as tightly as ``binding``."""
-        self.depth += 1
-        if self.depth > MAX_DEPTH:
-            raise self.error(f"operators and parentheses nested more than {MAX_DEPTH} deep")
+        """The selection from here whose operators bind at least as tightly as ``binding``; a
+        run of ``and`` (or of ``or``) is one operation of all its operands."""
+        entered = self.depth
+        self.deeper()
         tree = self.unary()
         while (kind := self.peek()) in _BINDING and _BINDING[kind] >= binding:
             if kind in ("and", "or"):
                 self.take(kind)
-                tree = Operation(kind, (tree, self.expression(_BINDING[kind] + 1)))
-            elif kind == "within":  # Y within 5 of X: the atoms of Y near X
+                operand = self.expression(_BINDING[kind] + 1)
+                runs_on = isinstance(tree, Operation) and tree.kind == kind
+                tree = Operation(kind, (*tree.operands, operand) if runs_on else (tree, operand))
+                continue
+            self.deeper()  # each distance operator wraps what came before it
+            if kind == "within":  # Y within 5 of X: the atoms of Y near X
                 tree = Operation("and", (tree, self.within()))
             elif kind == "zone":
                 tree = Operation("within", (tree,), self.reach(self.take("zone")))
             else:
                 self.take(kind)
                 tree = Operation(kind, (tree,), self.reach(self.take("word") if self.peek() == "word" else ""))
-        self.depth -= 1
+        self.depth = entered
         return tree
+
+    def deeper(self) -> None:
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise self.error(f"operators and parentheses nested more than {MAX_DEPTH} deep")
 
     def unary(self) -> Term | Operation:
         kind = self.peek()

@@ -138,7 +138,8 @@ def test_insertion_codes() -> None:
     ("chain A and ss Q", "secondary structure is H"), ("resi 9998 or resi 9999", r"no residue of a protein backbone is in 'resi 9998 or resi 9999' \(no residue resi 9998 in any chain; no residue resi 9999 in any chain\)"),
     ("chain A or name CA", "cannot read 'name CA' as residues"), ("/Q | /R", r"\(no chain Q; no chain R\)"),
     ("within 5 of", "a selection is missing at the end"), ("(" * 5000 + "chain A" + ")" * 5000, "nested more than 100"),
-    ("not " * 5000 + "chain A", "nested more than 100"), ("chain A within 5 resn HEM", "expected of before 'resn'"),
+    ("not " * 500 + "chain A", "nested more than 100"), ("A:40" + " around 1" * 200, "nested more than 100"),
+    ("chain A or " * 3000 + "chain B", "more than 1,000 operators"), ("chain A within 5 resn HEM", "expected of before 'resn'"),
     ("chain A and resn ILE", "no residue ILE in chain A"),
     ("#1", "cannot read"), ("/Z:5", "no chain Z"), ("chain B and resi 400", "no residue chain B and resi 400 in chain B"),
 ])
@@ -233,6 +234,7 @@ def _rows_where(structure, keep) -> np.ndarray:
     ("all and not strand", lambda s, k: True),  # haemoglobin has no strand
     ("(chain A or chain Q) and resi 10-20 or resi 9999", lambda s, k: s.chain == "A" and 10 <= s.resseq[k] <= 20),
     ("not (chain Q or resn XYZ)", lambda s, k: True),  # what is not there selects nothing, as in PyMOL
+    ("chain A or " * 900 + "chain B", lambda s, k: s.chain in "AB"),  # a long run of or is one operation
 ])
 def test_selections_combined_by_operators(haemoglobin, text: str, keep) -> None:
     rows = find_residues(haemoglobin, text, "A")
