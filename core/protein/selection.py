@@ -62,10 +62,9 @@ def tokens(text: str) -> list[tuple[str, str]]:
 
 def parse(text: str) -> Term | Operation:
     """The tree of ``text``; ValueError where its operators do not combine."""
-    found = tokens(text)
-    if sum(kind not in ("word", "open", "close", "of") for kind, _ in found) > MAX_OPERATORS:
-        raise _Parser(found, text).error(f"more than {MAX_OPERATORS:,} operators")
-    parser = _Parser(found, text)
+    parser = _Parser(tokens(text), text)
+    if sum(kind not in ("word", "open", "close", "of") for kind, _ in parser.tokens) > MAX_OPERATORS:
+        raise parser.error(f"more than {MAX_OPERATORS:,} operators")
     tree = parser.expression()
     if parser.position < len(parser.tokens):
         raise parser.error(f"{parser.tokens[parser.position][1]!r} where an operator or the end was expected")
