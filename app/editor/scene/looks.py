@@ -1,6 +1,6 @@
-"""What the 3D view looks like at first, in plain Python: the window's sketch of the molecule
+"""What the 3D view looks like, in plain Python: the window's sketch of the molecule
 (:mod:`app.editor.sketch`), drawn before VTK loads, takes the scene's view angle, background and
-colours from here."""
+colours from here; the scene also the backing of the texts it draws over the molecule."""
 
 from __future__ import annotations
 
@@ -16,3 +16,6 @@ SS_COLOURS: dict[str, RGB] = {"H": (222, 66, 91), "E": (246, 190, 0), "C": (176,
 """The ribbon's colour by secondary structure: helix, strand, other."""
 NUCLEIC_BACKBONE: RGB = (120, 120, 120)
 """The colour of the nucleic acids' backbone tube."""
+
+BACKING_OPACITY = 0.7
+"""Of the white box behind the texts drawn over the view (labels, the caption)."""

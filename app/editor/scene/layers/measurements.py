@@ -13,14 +13,13 @@ from app.editor.document import Change
 from app.editor.measurements import Measurement
 from app.editor.scene.layers.base import Layer, SceneLayer, Stage
 from app.editor.scene.layers.meshes import polylines
+from app.editor.scene.looks import BACKING_OPACITY
 
 COLOUR = (20, 110, 150)
 """The lines' and the texts' colour."""
 TEXT_PIXELS = 15
 LABEL_OFFSET = 0.6
 """Å a label's text stands off its atom."""
-BACKING_OPACITY = 0.7
-"""Of the white box behind each text."""
 
 
 class MeasurementsLayer(SceneLayer):
