@@ -2,11 +2,14 @@
 *Measure Angle* or *Measure Dihedral* makes the next clicks in the view pick atoms (a residue
 clicked where no atom is drawn gives its Cα, and a label of the residue) until there are
 enough; Esc or the same entry again stops. *Label Selected Residues* labels the residues of the
-selection at once (a binding site found with Go to Residue). They are listed in the
-*Measurements* dock and drawn in the view (:mod:`app.editor.scene.layers.measurements`)."""
+selection at once (a binding site found with Go to Residue); *Show Polar Contacts* measures
+the hydrogen-bonding distances from them to the atoms around (:mod:`core.geometry.contacts`).
+They are listed in the *Measurements* dock and drawn in the view
+(:mod:`app.editor.scene.layers.measurements`)."""
 
 from __future__ import annotations
 
+import numpy as np
 from PySide6.QtGui import QActionGroup, QKeySequence
 from PySide6.QtWidgets import QMainWindow
 
@@ -14,6 +17,7 @@ from app.editor.document import Document
 from app.editor.features.menus import Menus
 from app.editor.interaction.identify import Hit
 from app.editor.measurements import KINDS, checked
+from core.geometry.contacts import POLAR_REACH, polar_contacts
 
 TOOLS = {1: ("&Label", "Ctrl+Shift+L"), 2: ("Measure &Distance", "Ctrl+Shift+D"),
          3: ("Measure &Angle", "Ctrl+Shift+A"), 4: ("Measure Di&hedral", "Ctrl+Shift+H")}
@@ -36,9 +40,12 @@ class Measuring:
             action.setCheckable(True)
             self.tools.addAction(action)
         self.label_selection_action = menus.action("Label &Selected Residues", QKeySequence(), self.label_selection)
+        self.contacts_action = menus.action("Show Polar &Contacts of Selected Residues", QKeySequence(),
+                                            self.show_polar_contacts)
         self.clear_action = menus.action("Clear Measurements", QKeySequence(),
                                          lambda: document.measurements.replace([]))
-        menus.add("measure", *self.tools.actions(), self.label_selection_action, self.clear_action)
+        menus.add("measure", *self.tools.actions(), self.label_selection_action, self.contacts_action,
+                  self.clear_action)
         document.loaded.connect(lambda: self.use(0))
 
     def use(self, count: int) -> None:
@@ -50,15 +57,40 @@ class Measuring:
 
     def label_selection(self) -> None:
         """Label each selected residue (at its Cα) that has no label yet, all in one change."""
-        document = self.document
-        if document.model is None or not len(document.selection):
-            self.window.statusBar().showMessage("Select residues first: click them, or Go to Residue (Ctrl+L)", 8000)
+        if not self._selected():
             return
-        labelled = {m.atoms[0] for m in document.measurements.items if m.residue}
-        rows = [row for row in document.ca_rows[document.selection].tolist() if row not in labelled]
+        document = self.document
+        labelled = {m.atoms for m in document.measurements.items if m.residue}
+        rows = [(row,) for row in document.ca_rows[document.selection].tolist() if (row,) not in labelled]
+        self._add(rows, residue=True)
+
+    def show_polar_contacts(self) -> None:
+        """Measure each polar contact (N or O within 3.5 Å) from the selected residues to the
+        atoms of other residues and groups, waters aside, as the atoms are now; all in one change."""
+        if not self._selected():
+            return
+        document = self.document
+        chosen = np.flatnonzero(np.isin(document.structure.atom_residue, document.selection))
+        pairs = polar_contacts(document.structure.atoms, document.model.coords, chosen, among=False)
+        measured = {m.atoms for m in document.measurements.items}
+        self._add([pair for pair in map(tuple, pairs.tolist()) if pair not in measured and pair[::-1] not in measured])
+        self.window.statusBar().showMessage(
+            f"{len(pairs)} polar contact{'' if len(pairs) == 1 else 's'} (N and O {POLAR_REACH:g} Å apart or "
+            f"nearer) of {len(document.selection)} residue{'' if len(document.selection) == 1 else 's'}", 8000)
+
+    def _selected(self) -> bool:
+        """Whether residues are selected; if not, the status bar says how to select them."""
+        if self.document.model is None or not len(self.document.selection):
+            self.window.statusBar().showMessage("Select residues first: click them, or Go to Residue (Ctrl+L)", 8000)
+            return False
+        return True
+
+    def _add(self, atoms: list[tuple[int, ...]], residue: bool = False) -> None:
+        """New measurements of ``atoms`` (one tuple of rows each), all in one change."""
+        document = self.document
         n_atoms = len(document.model.coords)
-        document.measurements.replace(document.measurements.items + [checked((row,), n_atoms, residue=True)
-                                                                     for row in rows])
+        document.measurements.replace(document.measurements.items + [checked(rows, n_atoms, residue=residue)
+                                                                     for rows in atoms])
 
     def click(self, hit: Hit | None) -> bool:
         """A click in the view while a tool is in use picks the atom under it (a residue's Cα);

@@ -153,3 +153,23 @@ def test_the_residues_of_a_binding_site_are_labelled_at_once(open_window: Opener
     action.trigger()
     added = window.rw.measurements[len(pocket):]
     assert added == [label for label in window.rw.selection if label not in pocket] and len(added) == 3
+
+
+def test_the_polar_contacts_of_a_residue_are_measured_at_once(open_window: Opener) -> None:
+    """3PTB: Asp189 at the bottom of trypsin's pocket, selected with Go to Residue; *Show Polar
+    Contacts* measures its hydrogen-bonding distances, the salt bridge to benzamidine among
+    them, in one change; asked again, it adds none."""
+    window = open_window("3PTB.pdb.gz")
+    action, rw = window.measuring.contacts_action, window.rw
+    window.rw.go_to("A:189")
+    changes: list[int] = []
+    window.document.measurements.changed.connect(lambda: changes.append(1))
+    action.trigger()
+    measured = rw.measurements
+    assert {"A:ASP189 OD1 – A:BEN1 N1: 2.92 Å", "A:ASP189 OD2 – A:BEN1 N2: 2.87 Å"} <= set(measured) and changes == [1]
+    assert all(" – " in item and "A:ASP189" in item for item in measured)  # each from Asp189 to another
+    assert "2.92 Å" in _texts(window) and "2.87 Å" in _texts(window)
+    assert window.statusBar().currentMessage() == (f"{len(measured)} polar contacts (N and O 3.5 Å apart or nearer) "
+                                                   "of 1 residue")
+    action.trigger()
+    assert rw.measurements == measured

@@ -1,0 +1,76 @@
+"""Polar contacts on real entries, against gemmi's own contact search."""
+
+from pathlib import Path
+
+import gemmi
+import numpy as np
+import pytest
+
+from core.geometry.contacts import CLOSEST, POLAR_REACH, polar_contacts
+from core.protein.reading import read_structure
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+
+
+def _label(atoms, row: int) -> str:
+    return f"{atoms.chain[row]}:{atoms.resname[row]}{atoms.resseq[row]} {atoms.name[row]}"
+
+
+def test_benzamidine_in_trypsins_pocket() -> None:
+    """3PTB: the amidinium of the inhibitor bound to Asp189's carboxylate, Ser190 and Gly219,
+    as the structure papers describe it."""
+    trypsin = read_structure(DATA / "3PTB.pdb.gz")
+    atoms = trypsin.atoms
+    pairs = polar_contacts(atoms, trypsin.coords, np.flatnonzero(atoms.resname == "BEN"))
+    named = {(_label(atoms, a), _label(atoms, b)) for a, b in pairs}
+    assert {("A:ASP189 OD1", "A:BEN1 N1"), ("A:ASP189 OD2", "A:BEN1 N2"), ("A:SER190 OG", "A:BEN1 N2"),
+            ("A:GLY219 O", "A:BEN1 N1")} <= named
+    distances = np.linalg.norm(trypsin.coords[pairs[:, 0]] - trypsin.coords[pairs[:, 1]], axis=1)
+    assert np.all((distances >= CLOSEST) & (distances <= POLAR_REACH))
+
+
+@pytest.mark.parametrize(("name", "chain", "first", "last"), [("1UBQ.pdb.gz", "A", 40, 50), ("4HHB.pdb.gz", "B", 80, 95),
+                                                              ("1F9V.pdb.gz", "A", 480, 490)])
+def test_the_contacts_are_those_gemmi_finds(name: str, chain: str, first: int, last: int) -> None:
+    """Every N and O pair 2.5-3.5 Å apart, one atom in the residues chosen, the other in another
+    residue (not a water), first conformers, less two backbone N, two backbone O or a proline's
+    N: as gemmi's ContactSearch lists them."""
+    structure = read_structure(DATA / name)
+    atoms = structure.atoms
+    chosen = np.flatnonzero((atoms.chain == chain) & (atoms.resseq >= first) & (atoms.resseq <= last)
+                            & (atoms.category == "protein"))
+    ours = {tuple(pair) for pair in polar_contacts(atoms, structure.coords, chosen).tolist()}
+    st = gemmi.read_structure(str(DATA / name))
+    st.remove_alternative_conformations()
+    st.remove_waters()
+    search = gemmi.ContactSearch(POLAR_REACH)
+    search.ignore = gemmi.ContactSearch.Ignore.SameResidue
+    ns = gemmi.NeighborSearch(st[0], gemmi.UnitCell(), 5).populate()  # the model alone: no crystal mates
+    row_of = {(c, r, n): k for k, (c, r, n) in enumerate(zip(atoms.chain.tolist(), atoms.resseq.tolist(),
+                                                            atoms.name.tolist(), strict=True))
+              if atoms.altloc[k] in ("", "A")}
+    theirs = set()
+    for contact in search.find_contacts(ns):
+        ends = [(c.chain.name, c.residue.seqid.num, c.atom.name) for c in (contact.partner1, contact.partner2)]
+        partners = (contact.partner1, contact.partner2)
+        if contact.dist < CLOSEST or not all(c.atom.element.name in ("N", "O") for c in partners):
+            continue
+        backbone = [c.atom.name if c.atom.name in ("N", "O", "OXT") and gemmi.find_tabulated_residue(c.residue.name)
+                    .is_amino_acid() else "" for c in partners]
+        if ("" not in backbone and (backbone[0] == "N") == (backbone[1] == "N")) or any(
+                c.atom.name == "N" and c.residue.name == "PRO" for c in partners):
+            continue
+        rows = tuple(sorted(row_of[end] for end in ends))
+        if np.isin(rows, chosen).any():
+            theirs.add(rows)
+    assert len(ours) > 5 and ours == theirs
+
+
+def test_among_leaves_out_the_pairs_within_the_chosen() -> None:
+    ubiquitin = read_structure(DATA / "1UBQ.pdb.gz")
+    atoms = ubiquitin.atoms
+    helix = np.flatnonzero((atoms.resseq >= 23) & (atoms.resseq <= 34) & (atoms.category == "protein"))
+    every, outward = (polar_contacts(atoms, ubiquitin.coords, helix, among=among) for among in (True, False))
+    inside = np.isin(every, helix).all(axis=1)
+    assert inside.sum() >= 8  # the helix's own i -> i+4 hydrogen bonds
+    assert np.array_equal(outward, every[~inside])
