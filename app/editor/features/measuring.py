@@ -19,6 +19,8 @@ from app.editor.interaction.identify import Hit
 from app.editor.measurements import KINDS, checked
 from core.geometry.contacts import POLAR_REACH, polar_contacts
 
+MOST_AT_ONCE = 500
+"""Most labels or contacts made at once: more would hide the molecule, each a text drawn."""
 TOOLS = {1: ("&Label", "Ctrl+Shift+L"), 2: ("Measure &Distance", "Ctrl+Shift+D"),
          3: ("Measure &Angle", "Ctrl+Shift+A"), 4: ("Measure Di&hedral", "Ctrl+Shift+H")}
 """Each tool's entry and shortcut, by the atoms it picks."""
@@ -62,7 +64,7 @@ class Measuring:
         document = self.document
         labelled = {m.atoms for m in document.measurements.items if m.residue}
         rows = [(row,) for row in document.ca_rows[document.selection].tolist() if (row,) not in labelled]
-        self._add(rows, residue=True)
+        self._add(rows, "labels", residue=True)
 
     def show_polar_contacts(self) -> None:
         """Measure each polar contact (N or O within 3.5 Å) from the selected residues to the
@@ -73,10 +75,11 @@ class Measuring:
         chosen = np.flatnonzero(np.isin(document.structure.atom_residue, document.selection))
         pairs = polar_contacts(document.structure.atoms, document.model.coords, chosen, among=False)
         measured = {m.atoms for m in document.measurements.items}
-        self._add([pair for pair in map(tuple, pairs.tolist()) if pair not in measured and pair[::-1] not in measured])
-        self.window.statusBar().showMessage(
-            f"{len(pairs)} polar contact{'' if len(pairs) == 1 else 's'} (N and O {POLAR_REACH:g} Å apart or "
-            f"nearer) of {len(document.selection)} residue{'' if len(document.selection) == 1 else 's'}", 8000)
+        if self._add([pair for pair in map(tuple, pairs.tolist()) if pair not in measured and pair[::-1] not in measured],
+                     "polar contacts"):
+            self.window.statusBar().showMessage(
+                f"{len(pairs)} polar contact{'' if len(pairs) == 1 else 's'} (N and O {POLAR_REACH:g} Å apart or "
+                f"nearer) of {len(document.selection)} residue{'' if len(document.selection) == 1 else 's'}", 8000)
 
     def _selected(self) -> bool:
         """Whether residues are selected; if not, the status bar says how to select them."""
@@ -85,12 +88,18 @@ class Measuring:
             return False
         return True
 
-    def _add(self, atoms: list[tuple[int, ...]], residue: bool = False) -> None:
-        """New measurements of ``atoms`` (one tuple of rows each), all in one change."""
+    def _add(self, atoms: list[tuple[int, ...]], what: str, residue: bool = False) -> bool:
+        """New measurements of ``atoms`` (one tuple of rows each), all in one change; none, and
+        the status bar says why, past :data:`MOST_AT_ONCE` (returns whether they were made)."""
+        if len(atoms) > MOST_AT_ONCE:
+            self.window.statusBar().showMessage(f"{len(atoms):,} {what} would hide the molecule: select fewer "
+                                                f"residues (at most {MOST_AT_ONCE} at once)", 8000)
+            return False
         document = self.document
         n_atoms = len(document.model.coords)
         document.measurements.replace(document.measurements.items + [checked(rows, n_atoms, residue=residue)
                                                                      for rows in atoms])
+        return True
 
     def click(self, hit: Hit | None) -> bool:
         """A click in the view while a tool is in use picks the atom under it (a residue's Cα);

@@ -153,6 +153,11 @@ def test_the_residues_of_a_binding_site_are_labelled_at_once(open_window: Opener
     action.trigger()
     added = window.rw.measurements[len(pocket):]
     assert added == [label for label in window.rw.selection if label not in pocket] and len(added) == 3
+    window.rw.go_to("all")  # 573 residues: more labels than the view can show
+    action.trigger()
+    assert window.statusBar().currentMessage() == ("554 labels would hide the molecule: select fewer residues "
+                                                   "(at most 500 at once)")
+    assert len(window.rw.measurements) == len(pocket) + 3
 
 
 def test_the_polar_contacts_of_a_residue_are_measured_at_once(open_window: Opener) -> None:
