@@ -178,3 +178,26 @@ def test_the_polar_contacts_of_a_residue_are_measured_at_once(open_window: Opene
                                                    "of 1 residue")
     action.trigger()
     assert rw.measurements == measured
+
+
+def test_a_label_the_clip_slab_leaves_out_is_not_drawn(open_window: Opener, qtbot: QtBot) -> None:
+    """Labels are drawn over the molecule, not clipped with it: the one of a residue outside the
+    slab (Ctrl+K) is hidden, as PyMOL hides it, and shown again with the slab off."""
+    window = open_window("1TIM.pdb.gz")
+    rw, camera = window.rw, window.plotter.renderer.GetActiveCamera()
+    centre = np.array(camera.GetFocalPoint())
+    towards = np.array(camera.GetDirectionOfProjection())
+    document = window.document
+    depth = (document.model.coords[document.ca_rows] - centre) @ towards  # along the view, from its centre
+    near, far = int(np.argmin(np.abs(depth))), int(np.argmax(np.abs(depth)))
+    assert abs(depth[far]) > 20.0
+    for row in (near, far):
+        rw.measure(document.structure.residue_label(row))
+    texts = [window.scene.actors[f"measure_text_{k}"] for k in range(2)]
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow)
+    for shown in ([True, False], [True, True]):  # a slab 10 Å either side, then none
+        frames = window.plotter.frames
+        qtbot.keyClick(window.plotter, Qt.Key.Key_K, Qt.KeyboardModifier.ControlModifier)
+        qtbot.waitUntil(lambda frames=frames: window.plotter.frames > frames)
+        assert [bool(text.GetVisibility()) for text in texts] == shown

@@ -34,6 +34,8 @@ class MeasurementsLayer(SceneLayer):
         super().__init__(scene)
         self._texts: list[vtkTextActor] = []
         self._rows = np.empty(0, dtype=np.int64)
+        self._places = np.empty((0, 3))
+        """Where each text stands (Å)."""
         self.document.measurements.changed.connect(self._changed)
 
     def build(self) -> None:
@@ -45,6 +47,7 @@ class MeasurementsLayer(SceneLayer):
                                         if len(self._rows) else pv.PolyData())
         self.add("measure_lines", color=COLOUR, line_width=3.0, render_lines_as_tubes=True)
         self._texts = []
+        self._places = np.empty((len(items), 3))
         for k, measurement in enumerate(items):
             text = vtkTextActor()
             text.GetPositionCoordinate().SetCoordinateSystemToWorld()
@@ -60,24 +63,36 @@ class MeasurementsLayer(SceneLayer):
             self.actors[f"measure_text_{k}"] = text
             self.scene.plotter.add_actor(text, name=f"measure_text_{k}", reset_camera=False, render=False,
                                          pickable=False)
-            self._place(text, measurement, coords)
+            self._place(k, measurement, coords)
         self.show(self.visible)
 
     def update(self, change: Change) -> None:
         if len(self._rows) and np.isin(self._rows, change.rows).any():
             coords = self.document.model.coords
             self.write("measure_lines", slice(None), coords[self._rows])
-            for text, measurement in zip(self._texts, self.document.measurements.items):
-                self._place(text, measurement, coords)
+            for k, measurement in enumerate(self.document.measurements.items):
+                self._place(k, measurement, coords)
 
     def show(self, visible: bool) -> None:
         super().show(visible)
         for text in self._texts:
             text.SetVisibility(visible)
 
-    def _place(self, text: vtkTextActor, measurement: Measurement, coords: np.ndarray) -> None:
-        """Put ``measurement``'s text where it belongs: beside a label's atom, at the middle of
-        a distance, at an angle's vertex, at the middle of a dihedral's axis."""
+    def before_frame(self) -> None:
+        """Hide each text whose place the frame clips away: drawn over the molecule, the texts
+        are not clipped with it (behind the camera; outside a clip slab, as PyMOL's labels)."""
+        if not self._texts or not self.visible:
+            return
+        camera = self.scene.plotter.renderer.GetActiveCamera()
+        depth = (self._places - np.array(camera.GetPosition())) @ np.array(camera.GetDirectionOfProjection())
+        near, far = camera.GetClippingRange() if self.scene.slab is not None else (0.0, np.inf)
+        for text, shown in zip(self._texts, ((depth > near) & (depth < far)).tolist(), strict=True):
+            text.SetVisibility(shown)
+
+    def _place(self, k: int, measurement: Measurement, coords: np.ndarray) -> None:
+        """Put text ``k``, ``measurement``'s, where it belongs: beside a label's atom, at the
+        middle of a distance, at an angle's vertex, at the middle of a dihedral's axis."""
+        text = self._texts[k]
         xyz = coords[list(measurement.atoms)]
         if len(xyz) == 1:
             where = xyz[0] + LABEL_OFFSET
@@ -85,6 +100,7 @@ class MeasurementsLayer(SceneLayer):
             where = xyz[1]
         else:  # the middle of a distance, of a dihedral's axis
             where = xyz[len(xyz) // 2 - 1:len(xyz) // 2 + 1].mean(axis=0)
+        self._places[k] = where
         text.GetPositionCoordinate().SetValue(*map(float, where))
         text.SetInput(measurement.text(self.document.structure, coords))
 
