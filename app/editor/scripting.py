@@ -119,7 +119,7 @@ class EditorAPI:
         """Select ``residues`` (``'A:45'``, ``'45'`` in the edited chain, ``'A:40-50'``, ``'A:40-42, B:45'``;
         ChimeraX's ``'/A:40-50'``, PyMOL's ``'chain A and resi 40-50+60'``, a binding site
         ``'byres resn HEM around 5'``, these combined, ``'chain A and ss H'``: :mod:`core.protein.lookup`) and
-        centre the view on them, as Go to Residue (Ctrl+L) does; their chain becomes the edited
+        centre and zoom the view on them, as Go to Residue (Ctrl+L) does; their chain becomes the edited
         segment. A ligand, ion, water or nucleotide (``'A:HEM'``, ``'/B:20'``) is centred on,
         nothing selected. Returns the labels selected (ValueError for a residue that does not exist)."""
         document = self._document
