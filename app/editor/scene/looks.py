@@ -1,6 +1,6 @@
 """What the 3D view looks like, in plain Python: the window's sketch of the molecule
 (:mod:`app.editor.sketch`), drawn before VTK loads, takes the scene's view angle, background and
-colours from here; the scene also the backing of the texts it draws over the molecule."""
+colours from here; the scene also the backing of the labels it draws over the molecule."""
 
 from __future__ import annotations
 
@@ -18,4 +18,4 @@ NUCLEIC_BACKBONE: RGB = (120, 120, 120)
 """The colour of the nucleic acids' backbone tube."""
 
 BACKING_OPACITY = 0.7
-"""Of the white box behind the texts drawn over the view (labels, the caption)."""
+"""Of the white box behind each label and measured value drawn over the view."""

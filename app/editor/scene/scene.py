@@ -34,7 +34,7 @@ from app.editor.scene.layers.models import ModelsLayer
 from app.editor.scene.layers.nucleic import NucleicLayer
 from app.editor.scene.layers.selection import SelectionLayer
 from app.editor.scene.layers.tube import TubeLayer
-from app.editor.scene.looks import BACKGROUND, BACKING_OPACITY, FIT_CLOSER, VIEW_ANGLE
+from app.editor.scene.looks import BACKGROUND, FIT_CLOSER, VIEW_ANGLE
 from app.editor.scene.molecule import Colouring
 from core.geometry.principal import principal_directions
 
@@ -392,8 +392,6 @@ class Scene(QObject):
             style = actor.GetTextProperty()
             style.SetFontSize(CAPTION_PIXELS)
             style.SetColor(pv.Color(CAPTION_COLOUR).float_rgb)
-            style.SetBackgroundColor(1.0, 1.0, 1.0)  # legible over the molecule when zoomed in
-            style.SetBackgroundOpacity(BACKING_OPACITY)
             style.SetVerticalJustificationToTop()
             actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
             actor.SetPosition(0.008, 0.99)
