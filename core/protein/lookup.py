@@ -1,61 +1,37 @@
-"""Residues named as people type them: ``A:45``, ``45``, ``A45``, ``A:LYS45``, ``A:52A``,
-``A:40-50``, lists of these (``A:40-42, B:45, 50``); as ChimeraX specifies them (``/A:45-50``,
-``:45``, ``#1/A:45``, ``/A``, ``:his``, lists ``/A,B:40-42,50 /C:7``); and as PyMOL selects them
-(``chain A and resi 45-50``, ``resi 45``, ``c. A & i. 45``, ``resn HIS``, lists
-``chain A+B and resi 40-42+50``, ``/obj//A/45``, ``A/45/``, ``A/LYS`45/CA``). Any of these
-combine with PyMOL's and ChimeraX's operators (:mod:`core.protein.selection`): ``and``,
-``or``, ``not``, parentheses, and the residues near others or a ligand, as both select a
-binding site (``byres resn HEM around 5``, ``within 5 of A:45``; ``:HEM :<5``); with classes
-of residues and groups (``ss H``, ``helix``, ``polymer``, ``organic``, ``solvent``, ...):
-``chain A and ss H``, ``/A:40-60 & :HIS``, ``byres organic around 4 and not resn HOH``."""
+"""The residues, atoms and groups of a structure that a selection names, in any of the
+syntaxes :mod:`core.protein.selection` reads: ``A:45``, ``/A:40-50``, ``chain A and resi 45-50``,
+lists of these, and these combined by PyMOL's and ChimeraX's operators, among them the residues
+near others or a ligand, as both select a binding site (``byres resn HEM around 5``,
+``within 5 of A:45``; ``:HEM :<5``), with classes of residues and groups (``ss H``, ``helix``,
+``polymer``, ``organic``, ``solvent``, ...): ``chain A and ss H``, ``/A:40-60 & :HIS``,
+``byres organic around 4 and not resn HOH``."""
 
 from __future__ import annotations
 
-import itertools
 import re
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from core.protein.selection import OPERATORS, Operation, Term, parse, tokens
+from core.protein.selection import (
+    CHAIN,
+    HELP,
+    NAME,
+    OPERATORS,
+    Named,
+    Operation,
+    Term,
+    atom_parts,
+    parse,
+    read,
+    read_parts,
+    tokens,
+)
 from core.protein.structure import Structure
 
-_NUMBERS = r"(?P<first>-?\d+)(?P<icode>[A-Za-z]?)(?:\s*(?:-|–|\.\.)\s*(?P<last>-?\d+)(?P<last_icode>[A-Za-z]?))?"
-_CHAIN = r"[A-Za-z0-9]{1,4}"
-_OWN = re.compile(rf"(?:(?P<chain>{_CHAIN})\s*[:/]\s*|(?P<letter>[A-Za-z])(?=-?\d))?"
-                  rf"(?P<name>[A-Za-z]{{1,3}})?{_NUMBERS}")
-_NAME = r"(?=[A-Za-z0-9]*[A-Za-z])[A-Za-z0-9]{1,5}"
-"""A residue or ligand name (HIS, PO4, 5CM, A): letters and digits, at least one letter."""
-_CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{_CHAIN}))?\s*(?::(?:{_NUMBERS}|(?P<name>{_NAME})))?")
-_PYMOL_RESI = re.compile(rf"(?:(?P<name>[A-Za-z]{{3}})`)?{_NUMBERS}")
-_PYMOL_WORDS = {"chain": "chain", "c.": "chain", "resi": "resi", "i.": "resi", "resn": "resn", "r.": "resn"}
-HELP = ("type e.g. A:45, 45, A:40-50 or A:40-42, B:45; ChimeraX /A:45-50,60, :45, :his or :HEM :<5; PyMOL "
-        "chain A and resi 45-50+60, resi 45, resn HIS, byres resn HEM around 5, /obj//A/45 or A/45/; combined by "
-        "and, or, not and parentheses, with ss H, helix, polymer, organic or solvent")
-MAX_PARTS = 10_000
-"""Most parts (a residue, range or chain each) a list may name."""
 MAX_REACH = 50.0
 """Å: the farthest a selection of the residues near others reaches."""
-
-
-@dataclass(frozen=True)
-class _Named:
-    """What a text names, in any of the syntaxes: a residue or a range of them, a chain, or the
-    residues of a name (``first`` None and ``name`` given; in ``chain`` or in all)."""
-
-    chain: str | None = None
-    first: int | None = None
-    icode: str = ""
-    last: int | None = None
-    last_icode: str = ""
-    name: str | None = None
-
-    @classmethod
-    def of(cls, match: re.Match, chain: str | None, name: str | None = None) -> _Named:
-        last = match["last"]
-        return cls(chain, None if match["first"] is None else int(match["first"]), (match["icode"] or "").upper(),
-                   None if last is None else int(last), (match["last_icode"] or "").upper(), name)
 
 
 def find_residues(structure: Structure, text: str, chain: str | None = None, coords: np.ndarray | None = None
@@ -75,7 +51,7 @@ def find_residues(structure: Structure, text: str, chain: str | None = None, coo
     coords = structure.coords if coords is None else coords
     if not OPERATORS.isdisjoint(kind for kind, _ in tokens(text)):
         return _selected(structure, text, coords)
-    parts = _read_all(text.strip())
+    parts = read_parts(text.strip())
     if parts is None:
         return _selected(structure, text, coords)
     if len(parts) == 1:
@@ -104,7 +80,7 @@ def _merged(tree: Term | Operation) -> Term | Operation:
     operands = tuple(_merged(operand) for operand in tree.operands)
     if tree.kind == "and" and all(isinstance(operand, Term) for operand in operands):
         joined = " and ".join(operand.text for operand in operands)
-        if _read(joined) is not None:
+        if read(joined) is not None:
             return Term(joined)
     return Operation(tree.kind, operands, tree.reach)
 
@@ -146,7 +122,7 @@ def _term_atoms(structure: Structure, text: str, missing: list[str]) -> np.ndarr
         if "?" in codes:
             raise ValueError(f"{text.strip()!r}: secondary structure is H (helix), S (strand) or L (loop)")
         return _ss_atoms(structure, codes)
-    parts = _read_all(text.strip()) or ([(text.strip(), named)] if (named := _read(text.strip())) else None)
+    parts = read_parts(text.strip())
     if parts is None:
         raise ValueError(f"cannot read {text.strip()!r} as residues: {HELP}")
     chosen = np.zeros(len(atoms), dtype=bool)
@@ -158,7 +134,7 @@ def _term_atoms(structure: Structure, text: str, missing: list[str]) -> np.ndarr
     return chosen
 
 
-def _part_atoms(structure: Structure, part: str, named: _Named) -> np.ndarray:
+def _part_atoms(structure: Structure, part: str, named: Named) -> np.ndarray:
     """(n_atoms,) bool: the atoms of one part of a term (ValueError where it names nothing)."""
     atoms = structure.atoms
     if named.first is None:  # a chain, or every residue or group of a name
@@ -226,7 +202,7 @@ _CLASSES = {
 ChimeraX (``protein``, ``ligand``, ``ions``, ``solvent``, ``helix``, ``strand``, ``coil``) name them."""
 
 
-def _rows(structure: Structure, text: str, named: _Named, chain: str | None) -> np.ndarray:
+def _rows(structure: Structure, text: str, named: Named, chain: str | None) -> np.ndarray:
     """The rows of one residue, range or chain, ``named`` by ``text``."""
     chains = [s.chain for s in structure.segments]
     if named.chain is not None and named.chain not in chains:
@@ -260,7 +236,7 @@ def find_atom(structure: Structure, text: str, chain: str | None = None) -> int:
     protein's backbone, a ligand, ion, water or nucleotide, by its number or name
     (``A:HEM FE``, ``/A:HEM@FE``, ``A:142 FE``, ``/B:DA5@P``); the first alternate location.
     Raises ValueError naming what is missing or how to type it."""
-    residue, name = _atom_parts(text.strip())
+    residue, name = atom_parts(text.strip())
     if not name:
         raise ValueError(f"cannot read {text.strip()!r} as an atom: type e.g. A:48 NZ, /A:48@NZ or A/48/NZ")
     try:
@@ -287,9 +263,9 @@ def find_group(structure: Structure, text: str, chain: str | None = None) -> np.
     (``A:142``, ``A:HEM142``, ``/A:HEM``, ``resn HEM``) or ``A:HEM``, in ``chain`` when the
     text names none and that chain has it. None where the text names no such group;
     ValueError where it names several."""
-    readings = [_read(text.strip())]  # B:PO4 reads as residue 4 named PO, and as the group PO4 of chain B
-    if match := re.fullmatch(rf"(?P<chain>{_CHAIN})\s*:\s*(?P<name>{_NAME})", text.strip()):
-        readings.append(_Named(match["chain"], name=match["name"]))
+    readings = [read(text.strip())]  # B:PO4 reads as residue 4 named PO, and as the group PO4 of chain B
+    if match := re.fullmatch(rf"(?P<chain>{CHAIN})\s*:\s*(?P<name>{NAME})", text.strip()):
+        readings.append(Named(match["chain"], name=match["name"]))
     readings = [named for named in readings if named is not None and named.last is None
                 and (named.first is not None or named.name is not None)]
     if not readings:
@@ -311,7 +287,7 @@ def find_group(structure: Structure, text: str, chain: str | None = None) -> np.
     return rows
 
 
-def _group_atoms(structure: Structure, named: _Named, chain: str | None) -> np.ndarray:
+def _group_atoms(structure: Structure, named: Named, chain: str | None) -> np.ndarray:
     """(n_atoms,) bool: the atoms outside the backbone segments of the groups ``named``, in
     ``chain`` when it names none and that chain has them."""
     atoms = structure.atoms
@@ -332,111 +308,9 @@ def _group_label(structure: Structure, row: int) -> str:
     return f"{atoms.chain[row]}:{atoms.resname[row]}{atoms.resseq[row]}"
 
 
-def _atom_parts(text: str) -> tuple[str, str]:
-    """A residue's text and an atom's name, as the syntax of ``text`` splits them ('' for no atom)."""
-    terms = re.split(r"\s+and\s+|\s*&\s*", text, flags=re.IGNORECASE)
-    names = [term for term in terms if term.lower().startswith(("name ", "n. "))]
-    if len(terms) > 1 and len(names) == 1:
-        return " and ".join(term for term in terms if term not in names), names[0].split()[-1]
-    if "@" in text:
-        residue, _, name = text.rpartition("@")
-        return residue, name.strip()
-    if "/" in text and ":" not in text:
-        residue, _, name = text.rpartition("/")
-        return residue + "/", name.strip()
-    match = re.fullmatch(r"(.+?)\s+([A-Za-z0-9'*]{1,4})", text)
-    return (match[1], match[2]) if match else (text, "")
-
-
 def _label(structure: Structure, row: int) -> str:
     segment = next(s for s in structure.segments if s.residue_index[0] <= row <= s.residue_index[-1])
     return str(segment.labels[row - segment.residue_index[0]])
-
-
-def _read_all(text: str) -> list[tuple[str, _Named]] | None:
-    """Each part ``text`` names, with its own text: one as :func:`_read` reads it, else a list,
-    ChimeraX's (specs apart by spaces, chains and residues by commas), PyMOL's (values joined
-    by ``+``) or this module's (parts apart by commas), a part without a chain in the chain of
-    the part before it; None where a part is unreadable. ValueError past :data:`MAX_PARTS`."""
-    if (named := _read(text)) is not None:
-        return [(text, named)]
-    if text.startswith(("/", "#", ":")):
-        specs = [re.fullmatch(r"(?:#[\d.]+)?(?:/(?P<chains>[^:]+))?(?::(?P<residues>.+))?", spec)
-                 for spec in text.split()]
-        if any(match is None or not (match["chains"] or match["residues"]) for match in specs):
-            return None
-        choices = [[[f"/{c}" if c else "" for c in (match["chains"] or "").split(",")],
-                    [f":{r}" if r else "" for r in (match["residues"] or "").split(",")]] for match in specs]
-        join = ""
-    elif "+" in text:
-        terms = [term.strip().partition(" ") for term in re.split(r"\s+and\s+|\s*&\s*", text, flags=re.IGNORECASE)]
-        choices = [[[f"{word} {value.strip()}" for value in values.split("+")] for word, _, values in terms]]
-        join = " and "
-    else:
-        choices, join = [[[part.strip()]] for part in text.split(",")], ""
-    if sum(np.prod([len(values) for values in spec], dtype=float) for spec in choices) > MAX_PARTS:
-        raise ValueError(f"{text[:40]!r}... names more than {MAX_PARTS:,} residues, ranges or chains")
-    texts = [join.join(terms) for spec in choices for terms in itertools.product(*spec)]
-    parts, carried = [], None
-    for part in texts:
-        named = _read(part)
-        if named is None:
-            return None
-        if named.chain is None and carried is not None:
-            named = replace(named, chain=carried)
-        carried = named.chain
-        parts.append((part, named))
-    return parts if len(parts) > 1 else None
-
-
-def _read(text: str) -> _Named | None:
-    """``text`` read in the first syntax that reads it whole, or None."""
-    if match := _OWN.fullmatch(text):
-        return _Named.of(match, match["chain"] or match["letter"], match["name"])
-    if text.startswith(("/", "#", ":")) and (match := _CHIMERAX.fullmatch(text)) and (
-            match["chain"] or match["first"] or match["name"]):
-        return _Named.of(match, match["chain"], match["name"])
-    if "/" in text:
-        return _pymol_path(text)
-    return _pymol_words(text)
-
-
-def _pymol_path(text: str) -> _Named | None:
-    """PyMOL's ``/object/segment/chain/residue/atom``: from the left where it begins with a
-    slash, else from the right (``A/45/``: chain A, residue 45, any atom)."""
-    fields = [field.strip() for field in text.split("/")]
-    if text.startswith("/"):
-        chain, residue = (fields[1:] + [""] * 5)[2:4]
-    elif len(fields) >= 3:
-        chain, residue = fields[-3:-1]
-    else:
-        return None
-    if chain and not re.fullmatch(_CHAIN, chain):
-        return None
-    if not residue:
-        return _Named(chain) if chain else None
-    match = _PYMOL_RESI.fullmatch(residue)
-    return None if match is None else _Named.of(match, chain or None, match["name"])
-
-
-def _pymol_words(text: str) -> _Named | None:
-    """PyMOL's property selectors joined by ``and`` (or ``&``): ``chain A and resi 45-50``,
-    ``c. A & i. 45``, ``resn LYS and resi 45``, ``resn HIS`` (every histidine)."""
-    found: dict[str, str] = {}
-    for term in re.split(r"\s+and\s+|\s*&\s*", text.strip(), flags=re.IGNORECASE):
-        word, _, value = term.strip().partition(" ")
-        key = _PYMOL_WORDS.get(word.lower())
-        if key is None or key in found or not value.strip():
-            return None
-        found[key] = value.strip()
-    chain, name = found.get("chain"), found.get("resn")
-    if (chain is not None and not re.fullmatch(_CHAIN, chain)) or (name is not None
-                                                                   and not re.fullmatch(_NAME, name)):
-        return None
-    if "resi" not in found:
-        return _Named(chain, name=name) if chain is not None or name is not None else None
-    match = re.fullmatch(_NUMBERS, found["resi"])
-    return None if match is None else _Named.of(match, chain, name)
 
 
 def _row(structure: Structure, chain: str | None, number: int, icode: str, name: str | None, text: str) -> int:

@@ -81,8 +81,8 @@ def residue_colours(structure: Structure, colouring: Colouring | str) -> np.ndar
             along[rows] = np.arange(len(rows)) / max(len(rows) - 1, 1)
         return rainbow(along)
     if colouring is Colouring.B_FACTOR:  # each residue's Cα, blue (lowest) to white to red (highest)
-        b = structure.atoms.b_factor[ca_rows(structure)]
-        low, high = _b_range(structure)
+        b = _calpha_b(structure)
+        low, high = b.min(), b.max()
         return blue_white_red((b - low) / (high - low) if high > low else np.full(len(b), 0.5))
     order = {name: k for k, name in enumerate(dict.fromkeys(s.chain for s in segments))}
     colours = [CHAIN_PALETTE[order[s.chain] % len(CHAIN_PALETTE)] for s in segments for _ in range(len(s))]
@@ -99,7 +99,8 @@ def legend(structure: Structure, colouring: Colouring | str) -> list[tuple[str, 
     if colouring is Colouring.RAINBOW:
         return [("N-terminus", _rgb(rainbow(np.zeros(1)))), ("C-terminus", _rgb(rainbow(np.ones(1))))]
     if colouring is Colouring.B_FACTOR:
-        low, high = _b_range(structure)
+        b = _calpha_b(structure)
+        low, high = (float(b.min()), float(b.max())) if len(b) else (0.0, 0.0)
         if high <= low:
             return [(f"B {low:.0f} Å² (every Cα)", _rgb(blue_white_red(np.full(1, 0.5))))]
         return [(f"B {value:.0f} Å²", _rgb(blue_white_red(np.full(1, share))))
@@ -131,10 +132,9 @@ def _rgb(colours: np.ndarray) -> RGB:
     return red, green, blue
 
 
-def _b_range(structure: Structure) -> tuple[float, float]:
-    """The lowest and highest B-factor of the backbone's Cα (Å²)."""
-    b = structure.atoms.b_factor[ca_rows(structure)]
-    return (float(b.min()), float(b.max())) if len(b) else (0.0, 0.0)
+def _calpha_b(structure: Structure) -> np.ndarray:
+    """The B-factor (Å²) of each backbone residue's Cα."""
+    return structure.atoms.b_factor[ca_rows(structure)]
 
 
 def element_colours(elements: np.ndarray, carbon: RGB | None = None) -> np.ndarray:
