@@ -75,7 +75,7 @@ class Document(QObject):
     fileChanged = Signal()
     """The file name, the save target or the modified state changed."""
     selectionChanged = Signal()
-    """The selected residues changed (see :attr:`selection`)."""
+    """The selected residues or groups changed (see :attr:`selection`, :attr:`selected_groups`)."""
     saved = Signal()  # (by :meth:`save`)
 
     def __init__(self, parent: QObject | None = None) -> None:
@@ -100,6 +100,8 @@ class Document(QObject):
         self.pick: Pick | None = None
         self.selection = np.empty(0, dtype=np.int64)
         """Selected residues: rows of the residue table, sorted (any segments)."""
+        self.selected_groups = np.empty(0, dtype=np.int64)
+        """Selected ligands, ions, waters and nucleotides: coordinate rows of whole groups, sorted."""
         self.regularize_on_release = True
         """A drag's undo step holds the edit followed by :func:`core.geometry.regularize.regularized`."""
         self.regularize_while_dragging = False
@@ -272,13 +274,18 @@ class Document(QObject):
         current level curve would move."""
         return self._model.move_point(self.segment, self.shown_level(), index, np.array([1.0, 0.0, 0.0])).residues
 
-    def select(self, rows: np.ndarray | list[int]) -> None:
-        """Select residues by residue-table row (none: an empty selection)."""
+    def select(self, rows: np.ndarray | list[int], groups: np.ndarray | list[int] = ()) -> None:
+        """Select residues by residue-table row and groups outside the backbone segments by
+        coordinate row (none: an empty selection)."""
         rows = np.unique(np.asarray(rows, dtype=np.int64))
+        groups = np.unique(np.asarray(groups, dtype=np.int64))
         if len(rows) and not 0 <= rows[0] <= rows[-1] < self.structure.n_residues:
             raise ValueError(f"residue rows must be in [0, {self.structure.n_residues - 1}]")
-        if not np.array_equal(rows, self.selection):
-            self.selection = rows
+        if len(groups) and not (0 <= groups[0] <= groups[-1] < self.structure.n_atoms
+                                and (self.structure.atom_residue[groups] < 0).all()):
+            raise ValueError("a selected group's rows must be atoms outside the backbone segments")
+        if not np.array_equal(rows, self.selection) or not np.array_equal(groups, self.selected_groups):
+            self.selection, self.selected_groups = rows, groups
             self.selectionChanged.emit()
 
     @property
@@ -403,7 +410,7 @@ class Document(QObject):
         self.segment = segment if keep_view and segment < len(model.ribbons) else longest
         self.level = min(level, self.max_level) if keep_view else float(max(0, round(self.max_level - LEVELS_BELOW_MAX)))
         self.pick = None
-        self.selection = np.empty(0, dtype=np.int64)
+        self.selection = self.selected_groups = np.empty(0, dtype=np.int64)
         self._preview = None
         self._curves.clear()
         self.kept_view = keep_view

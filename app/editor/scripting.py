@@ -17,7 +17,7 @@ import numpy as np
 
 from app.editor.features.export import export_view
 from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
-from core.protein.lookup import find_atom, find_group, find_residues
+from core.protein.lookup import Selected, find_atom, find_group, find_residues
 
 if TYPE_CHECKING:
     from app.editor.docks.panels import DisplayPanel
@@ -111,19 +111,18 @@ class EditorAPI:
 
     @property
     def selection(self) -> list[str]:
-        """Labels of the selected residues, e.g. ``['A:LYS48']``."""
+        """Labels of the selected residues, then groups, e.g. ``['A:LYS48', 'A:BEN1']``."""
         document = self._document
-        return [document.structure.residue_label(int(row)) for row in document.selection]
+        return Selected(document.selection, document.selected_groups).labels(document.structure)
 
     def go_to(self, residues: str) -> list[str]:
         """Select ``residues`` (``'A:45'``, ``'45'`` in the edited chain, ``'A:40-50'``, ``'A:40-42, B:45'``;
         ChimeraX's ``'/A:40-50'``, PyMOL's ``'chain A and resi 40-50+60'``, a binding site
-        ``'byres resn HEM around 5'``, these combined, ``'chain A and ss H'``: :mod:`core.protein.lookup`) and
-        centre and zoom the view on them, as Go to Residue (Ctrl+L) does; their chain becomes the edited
-        segment. A ligand, ion, water or nucleotide (``'A:HEM'``, ``'/B:20'``) is centred on,
-        nothing selected. Returns the labels selected (ValueError for a residue that does not exist)."""
-        document = self._document
-        return [document.structure.residue_label(int(row)) for row in self._editor.navigation.go_to(residues)]
+        ``'byres resn HEM around 5'``, these combined, ``'chain A and ss H'``: :mod:`core.protein.lookup`),
+        or a ligand, ion, water or nucleotide (``'A:HEM'``, ``'resn BEN'``, ``'/B:20'``, ``'organic'``)
+        and centre and zoom the view on them, as Go to Residue (Ctrl+L) does; their chain becomes the
+        edited segment. Returns the labels selected (ValueError for a residue that does not exist)."""
+        return self._editor.navigation.go_to(residues).labels(self._document.structure)
 
     def measure(self, *atoms: int | str) -> float | None:
         """Label one atom (or, named without an atom, ``'A:48'``, its residue; ``'A:HEM'``, a

@@ -13,6 +13,7 @@ from PySide6.QtWidgets import QLabel, QMessageBox, QStatusBar, QStyle, QToolButt
 
 from app import PROG
 from app.editor.interaction.drag import Mode
+from core.protein.lookup import Selected
 
 if TYPE_CHECKING:
     from app.editor.document import Document
@@ -67,7 +68,7 @@ class StatusBar:
         labels["segment"].setText(f"chain {document.structure.segments[document.segment].summary}")
         labels["level"].setText(f"level {document.shown_level():.2f} / {document.max_level:.2f}")
         pick = document.pick
-        if len(document.selection) and pick is None:
+        if (len(document.selection) or len(document.selected_groups)) and pick is None:
             labels["pick"].setText(f"selected {selection_text(document)}; Esc clears")
             return
         idle = ("Click a control point to pick it; drag it to edit." if self.controller.mode is Mode.POINT
@@ -94,16 +95,24 @@ class StatusBar:
 
 
 def selection_text(document: Document, named: int = 4) -> str:
-    """The selected residues in a few words: a run as ``A:LYS40–A:TYR42 (3 residues)``, others
-    as ``13 residues: A:ASP189, A:SER190, A:CYS191 … A:TYR228`` (the first ``named`` and the last)."""
+    """The selection in a few words: a run of residues as ``A:LYS40–A:TYR42 (3 residues)``,
+    others as ``13 residues: A:ASP189, A:SER190, A:CYS191 … A:TYR228`` (the first ``named``
+    and the last), then groups by name, ``A:BEN1``, or by number, ``56 groups: A:HOH143 … A:HOH198``."""
     rows = document.selection
     label = document.structure.residue_label
     segments = document.structure.residue_place(rows)[0]
-    if np.all(np.diff(rows) == 1) and len(set(segments.tolist())) == 1:  # one run
+    if not len(rows):
+        residues = ""
+    elif np.all(np.diff(rows) == 1) and len(set(segments.tolist())) == 1:  # one run
         first, last = label(int(rows[0])), label(int(rows[-1]))
-        return f"{first if first == last else f'{first}–{last}'} ({len(rows)} residues)"
-    shown = ", ".join(label(int(row)) for row in rows[:named])
-    return f"{len(rows)} residues: {shown}" + (f" … {label(int(rows[-1]))}" if len(rows) > named else "")
+        residues = first if first == last else f"{first}–{last} ({len(rows)} residues)"
+    else:
+        shown = ", ".join(label(int(row)) for row in rows[:named])
+        residues = f"{len(rows)} residues: {shown}" + (f" … {label(int(rows[-1]))}" if len(rows) > named else "")
+    groups = Selected(rows[:0], document.selected_groups).labels(document.structure)
+    if len(groups) > 2:
+        groups = [f"{len(groups)} groups: {groups[0]} … {groups[-1]}"]
+    return " and ".join([residues] + groups if residues else groups)
 
 
 def _listed(notes: tuple[str, ...], most: int) -> str:

@@ -9,7 +9,7 @@ near others or a ligand, as both select a binding site (``byres resn HEM around 
 from __future__ import annotations
 
 import re
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -63,13 +63,93 @@ def _selected(structure: Structure, text: str, coords: np.ndarray) -> np.ndarray
     """The backbone residues of a selection combined by operators (:mod:`core.protein.selection`),
     its terms read in every chain where they name none; a term that names nothing there is
     empty, as in PyMOL (``(chain A or chain B) and resi 10-20`` of a one-chain protein)."""
-    missing: list[str] = []
-    atoms = _atoms_of(structure, _merged(parse(text)), coords, missing)
+    atoms, missing = _combined_atoms(structure, text, coords)
     rows = np.unique(structure.atom_residue[atoms & (structure.atom_residue >= 0)])
     if not len(rows):
-        raise ValueError(f"no residue of a protein backbone is in {text.strip()!r}"
-                         + (f" ({'; '.join(dict.fromkeys(missing))})" if missing else ""))
+        raise ValueError(f"no residue of a protein backbone is in {text.strip()!r}" + _missing(missing))
     return rows
+
+
+def _combined_atoms(structure: Structure, text: str, coords: np.ndarray) -> tuple[np.ndarray, list[str]]:
+    """(n_atoms,) bool: the atoms of the whole residues and groups that a selection combined by
+    operators selects, and what its terms name that the structure lacks."""
+    missing: list[str] = []
+    return _atoms_of(structure, _merged(parse(text)), coords, missing), missing
+
+
+def _missing(missing: list[str]) -> str:
+    return f" ({'; '.join(dict.fromkeys(missing))})" if missing else ""
+
+
+@dataclass(frozen=True, eq=False)
+class Selected:
+    """What a selection names: backbone residues (residue-table rows) and whole groups outside
+    the backbone segments (ligands, ions, waters, nucleotides: coordinate rows), both sorted."""
+
+    residues: np.ndarray
+    groups: np.ndarray
+
+    def labels(self, structure: Structure) -> list[str]:
+        """``['A:ASP189', ..., 'A:BEN1']``: the residues, then each group once."""
+        return ([structure.residue_label(int(row)) for row in self.residues]
+                + [_group_label(structure, int(row)) for row in self.groups[group_starts(structure, self.groups)]])
+
+
+def _named(structure: Structure, text: str, parts: list[tuple[str, Named]], chain: str | None) -> Selected:
+    """The residues and groups of a name or a list of them (:func:`find_selection`): each part a
+    residue, range or chain as :func:`find_residues` reads it, else the groups it names (a
+    range: every number in it, residues and groups, in ``chain`` where it names none, as
+    PyMOL's ``resi``); a part that names nothing selects nothing, and ValueError where none
+    names anything."""
+    residues, groups, missing = [], [], []
+    for part, named in parts:
+        try:
+            residues.append(_rows(structure, part, named, chain))
+            continue
+        except ValueError as error:
+            missing.append(str(error))
+        if named.last is not None:
+            try:
+                atoms = _part_atoms(structure, part, replace(named, chain=named.chain or chain))
+            except ValueError:
+                continue
+            residues.append(structure.atom_residue[atoms & (structure.atom_residue >= 0)])
+            groups.append(np.flatnonzero(atoms & (structure.atom_residue < 0)))
+        elif len(parts) == 1:  # one group (``A:HEM142``), or every one of its name (``/A:HOH``)
+            groups.append(find_group(structure, text, chain, several=True))
+        else:
+            groups.append(np.flatnonzero(_group_atoms(structure, named, chain)))
+    residues = np.unique(np.concatenate(residues or [np.empty(0, dtype=np.int64)]))
+    groups = np.unique(np.concatenate([found for found in groups if found is not None] or [residues[:0]]))
+    if not len(residues) and not len(groups):
+        raise ValueError("; ".join(dict.fromkeys(missing)))
+    return Selected(residues, groups.astype(np.int64))
+
+
+def group_starts(structure: Structure, groups: np.ndarray) -> np.ndarray:
+    """Indices into ``groups`` (sorted coordinate rows of whole groups) where each group begins."""
+    return np.flatnonzero(np.r_[True, np.diff(structure.atoms.residue[groups]) != 0]) if len(groups) else groups[:0]
+
+
+def find_selection(structure: Structure, text: str, chain: str | None = None, coords: np.ndarray | None = None
+                   ) -> Selected:
+    """The residues and groups named by ``text``: residues as :func:`find_residues` reads them,
+    or one group as :func:`find_group` does (``A:HEM``, ``resn BEN``), or every group of a name
+    (``resn HOH``); in a selection combined by operators, the groups it holds beside its
+    residues (``resn BEN or byres resn BEN around 4``: a ligand and its pocket). Raises
+    ValueError where it names nothing, or how to type it."""
+    coords = structure.coords if coords is None else coords
+    if OPERATORS.isdisjoint(kind for kind, _ in tokens(text)):  # names, or a class (``all``: below)
+        if (parts := read_parts(text.strip())) is not None:
+            return _named(structure, text, parts, chain)
+        if (groups := find_group(structure, text, chain, several=True)) is not None:  # ``A:HEM``
+            return Selected(groups[:0], groups)
+    atoms, missing = _combined_atoms(structure, text, coords)
+    selected = Selected(np.unique(structure.atom_residue[atoms & (structure.atom_residue >= 0)]),
+                        np.flatnonzero(atoms & (structure.atom_residue < 0)))
+    if not len(selected.residues) and not len(selected.groups):
+        raise ValueError(f"nothing is in {text.strip()!r}" + _missing(missing))
+    return selected
 
 
 def _merged(tree: Term | Operation) -> Term | Operation:
@@ -147,25 +227,31 @@ def _part_atoms(structure: Structure, part: str, named: Named) -> np.ndarray:
             raise ValueError(f"no residue or ligand {named.name.upper()}"
                              + (f" in chain {named.chain}" if named.chain is not None else ""))
         return here
+    numbered = (structure.atom_residue < 0) & ((atoms.chain == named.chain) if named.chain is not None else True)
+    if named.name is not None:
+        numbered &= atoms.resname == named.name.upper()
     if named.last is not None and not named.icode and not named.last_icode:  # every number in the range, as PyMOL
         low, high = sorted((named.first, named.last))
         rows = np.concatenate([s.residue_index[(s.resseq >= low) & (s.resseq <= high)
                                                & ((s.resname == named.name.upper()) if named.name else True)]
                                for s in structure.segments if named.chain in (None, s.chain)] or [np.empty(0, int)])
-        if not len(rows):
+        chosen = np.isin(structure.atom_residue, rows) | (numbered & (atoms.resseq >= low) & (atoms.resseq <= high))
+        if not chosen.any():
             raise ValueError(f"no residue {part.strip()}" + (f" in chain {named.chain}" if named.chain else " in any chain"))
-        return np.isin(structure.atom_residue, rows)
+        return chosen
     chains = [named.chain] if named.chain is not None else list(dict.fromkeys(s.chain for s in structure.segments))
-    found = []
+    found, missing = [np.empty(0, dtype=np.int64)], f"no residue {part.strip()} in any chain"
     for chain in chains:
         try:
             found.append(_rows(structure, part, replace(named, chain=chain), None))
-        except ValueError:
-            if named.chain is not None:
-                raise
-    if not found:
-        raise ValueError(f"no residue {part.strip()} in any chain")
-    return np.isin(structure.atom_residue, np.concatenate(found))
+        except ValueError as error:
+            missing = str(error) if named.chain is not None else missing
+    chosen = np.isin(structure.atom_residue, np.concatenate(found))
+    if named.last is None and not named.icode:  # a ligand, ion or water of the number, as PyMOL's resi
+        chosen |= numbered & (atoms.resseq == named.first)
+    if not chosen.any():
+        raise ValueError(missing)
+    return chosen
 
 
 def _ss_atoms(structure: Structure, codes: set[str]) -> np.ndarray:
@@ -257,12 +343,13 @@ def find_atom(structure: Structure, text: str, chain: str | None = None) -> int:
     return int(atoms[0])
 
 
-def find_group(structure: Structure, text: str, chain: str | None = None) -> np.ndarray | None:
+def find_group(structure: Structure, text: str, chain: str | None = None, *, several: bool = False
+               ) -> np.ndarray | None:
     """Coordinate rows of the one group outside the backbone segments (a ligand, ion, water or
     nucleotide) named by ``text``: by its number, name or both, as residues are named
     (``A:142``, ``A:HEM142``, ``/A:HEM``, ``resn HEM``) or ``A:HEM``, in ``chain`` when the
     text names none and that chain has it. None where the text names no such group;
-    ValueError where it names several."""
+    ValueError where it names several, unless ``several`` (then all of them)."""
     readings = [read(text.strip())]  # B:PO4 reads as residue 4 named PO, and as the group PO4 of chain B
     if match := re.fullmatch(rf"(?P<chain>{CHAIN})\s*:\s*(?P<name>{NAME})", text.strip()):
         readings.append(Named(match["chain"], name=match["name"]))
@@ -280,7 +367,7 @@ def find_group(structure: Structure, text: str, chain: str | None = None) -> np.
             raise ValueError(f"no residue or group {match['name'].upper()} in chain {match['chain']}")
         return None
     groups, first = np.unique(structure.atoms.residue[rows], return_index=True)
-    if len(groups) > 1:
+    if len(groups) > 1 and not several:
         names = [_group_label(structure, int(row)) for row in rows[np.sort(first)][:6].tolist()]
         raise ValueError(f"{text.strip()!r} names {len(groups)} groups ({', '.join(names)}"
                          + (", ..." if len(groups) > 6 else "") + "): name one")

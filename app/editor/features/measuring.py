@@ -1,9 +1,11 @@
 """Labels and measurements picked with the mouse: *View ▸ Label*, *Measure Distance*,
 *Measure Angle* or *Measure Dihedral* makes the next clicks in the view pick atoms (a residue
 clicked where no atom is drawn gives its Cα, and a label of the residue) until there are
-enough; Esc or the same entry again stops. *Label Selected Residues* labels the residues of the
-selection at once (a binding site found with Go to Residue); *Show Polar Contacts* measures
-the hydrogen-bonding distances from them to the atoms around (:mod:`core.geometry.contacts`).
+enough; Esc or the same entry again stops. *Label Selection* labels the residues and ligands of
+the selection at once (a binding site found with Go to Residue); *Show Polar Contacts* measures
+the hydrogen-bonding distances from them to the atoms around (:mod:`core.geometry.contacts`):
+of a ligand selected (``resn BEN``), its hydrogen bonds to the protein, whose residues join the
+selection so that their atoms show.
 They are listed in the *Measurements* dock and drawn in the view
 (:mod:`app.editor.scene.layers.measurements`)."""
 
@@ -17,7 +19,9 @@ from app.editor.document import Document
 from app.editor.features.menus import Menus
 from app.editor.interaction.identify import Hit
 from app.editor.measurements import KINDS, checked
+from app.editor.status_bar import selection_text
 from core.geometry.contacts import POLAR_REACH, polar_contacts
+from core.protein.lookup import group_starts
 
 MOST_AT_ONCE = 500
 """Most labels or contacts made at once: more would hide the molecule, each a text drawn."""
@@ -41,8 +45,8 @@ class Measuring:
             action = menus.action(text, QKeySequence(key), lambda on, count=count: self.use(count if on else 0))
             action.setCheckable(True)
             self.tools.addAction(action)
-        self.label_selection_action = menus.action("Label &Selected Residues", QKeySequence(), self.label_selection)
-        self.contacts_action = menus.action("Show Polar &Contacts of Selected Residues", QKeySequence(),
+        self.label_selection_action = menus.action("Label &Selection", QKeySequence(), self.label_selection)
+        self.contacts_action = menus.action("Show Polar &Contacts of Selection", QKeySequence(),
                                             self.show_polar_contacts)
         self.clear_action = menus.action("Clear Measurements", QKeySequence(),
                                          lambda: document.measurements.replace([]))
@@ -58,33 +62,53 @@ class Measuring:
         self._say()
 
     def label_selection(self) -> None:
-        """Label each selected residue (at its Cα) that has no label yet, all in one change."""
+        """Label each selected residue (at its Cα) and group (at its first atom) that has no
+        label yet, all in one change."""
         if not self._selected():
             return
         document = self.document
         labelled = {m.atoms for m in document.measurements.items if m.residue}
-        rows = [(row,) for row in document.ca_rows[document.selection].tolist() if (row,) not in labelled]
+        groups = document.selected_groups
+        firsts = groups[group_starts(document.structure, groups)]
+        rows = [(row,) for row in np.concatenate([document.ca_rows[document.selection], firsts]).tolist()
+                if (row,) not in labelled]
         self._add(rows, "labels", residue=True)
 
     def show_polar_contacts(self) -> None:
-        """Measure each polar contact (N or O within 3.5 Å) from the selected residues to the
-        atoms of other residues and groups, waters aside, as the atoms are now; all in one change."""
+        """Measure each polar contact (N or O within 3.5 Å) from the selected residues and
+        groups to the atoms of other residues and groups, waters aside, as the atoms are now;
+        all in one change. The residues and groups contacted join the selection."""
         if not self._selected():
             return
         document = self.document
-        chosen = np.flatnonzero(np.isin(document.structure.atom_residue, document.selection))
+        chosen = np.union1d(np.flatnonzero(np.isin(document.structure.atom_residue, document.selection)),
+                            document.selected_groups)
         pairs = polar_contacts(document.structure.atoms, document.model.coords, chosen, among=False)
         measured = {m.atoms for m in document.measurements.items}
+        described = selection_text(document)
         if self._add([pair for pair in map(tuple, pairs.tolist()) if pair not in measured and pair[::-1] not in measured],
                      "polar contacts"):
+            self._reveal(pairs[~np.isin(pairs, chosen)])
             self.window.statusBar().showMessage(
                 f"{len(pairs)} polar contact{'' if len(pairs) == 1 else 's'} (N and O {POLAR_REACH:g} Å apart or "
-                f"nearer) of {len(document.selection)} residue{'' if len(document.selection) == 1 else 's'}", 8000)
+                f"nearer) of {described}", 8000)
+
+    def _reveal(self, partners: np.ndarray) -> None:
+        """Add the residues and groups of the atoms ``partners`` to the selection, so that their
+        atoms show at the other end of the contacts (as ChimeraX's ``reveal``)."""
+        document = self.document
+        structure = document.structure
+        residue = structure.atom_residue
+        groups = np.isin(structure.atoms.residue, structure.atoms.residue[partners]) & (residue < 0)
+        document.select(np.union1d(document.selection, residue[partners][residue[partners] >= 0]),
+                        np.union1d(document.selected_groups, np.flatnonzero(groups)))
 
     def _selected(self) -> bool:
-        """Whether residues are selected; if not, the status bar says how to select them."""
-        if self.document.model is None or not len(self.document.selection):
-            self.window.statusBar().showMessage("Select residues first: click them, or Go to Residue (Ctrl+L)", 8000)
+        """Whether residues or groups are selected; if not, the status bar says how to select them."""
+        document = self.document
+        if document.model is None or not (len(document.selection) or len(document.selected_groups)):
+            self.window.statusBar().showMessage("Select residues or a ligand first: click them, or Go to Residue "
+                                                "(Ctrl+L)", 8000)
             return False
         return True
 

@@ -10,7 +10,7 @@ import numpy as np
 from PySide6.QtGui import QKeySequence
 from PySide6.QtWidgets import QLineEdit, QMainWindow, QStyle
 
-from core.protein.lookup import find_group, find_residues
+from core.protein.lookup import Selected, find_selection
 
 if TYPE_CHECKING:
     from app.editor.document import Document
@@ -39,7 +39,7 @@ class Navigation:
                                       "as in ChimeraX (/A:40-50, :45, /A, :his, :HEM :<5) or PyMOL (chain A and "
                                       "resi 40-50+60, resi 45, A/45/, byres resn HEM around 5); combined by and, or, "
                                       "not and parentheses, with ss H, helix, polymer, organic or solvent (chain A "
-                                      "and ss H, /A:40-60 & :HIS); a ligand (A:HEM) to centre on it")
+                                      "and ss H, /A:40-60 & :HIS); ligands too (A:HEM, resn BEN, organic)")
         self.reset_view_action = menus.action("&Reset View", QKeySequence("Ctrl+R"), self._reset_view,
                                               window.style().standardIcon(QStyle.StandardPixmap.SP_BrowserReload))
         self.go_to_field = QLineEdit()
@@ -51,13 +51,14 @@ class Navigation:
         menus.add("camera", self.reset_view_action, self.go_to_action)
         menus.add_tools("camera", self.reset_view_action, self.go_to_field)
 
-    def select(self, rows: np.ndarray | list[int]) -> None:
-        """Select residues ``rows``; where they lie in one segment, that segment becomes the
+    def select(self, rows: np.ndarray | list[int], groups: np.ndarray | list[int] = ()) -> None:
+        """Select residues ``rows`` and groups ``groups`` (coordinate rows of ligands, ions,
+        waters or nucleotides); where the residues lie in one segment, that segment becomes the
         edited one (framed: centre afterwards)."""
         segments = set(self.document.structure.residue_place(rows)[0].tolist())
         if len(segments) == 1:
             self.document.set_segment(segments.pop())
-        self.document.select(rows)
+        self.document.select(rows, groups)
 
     def select_and_centre(self, rows: np.ndarray, point: np.ndarray | None = None) -> None:
         """Select residues ``rows`` (residue-table rows; see :meth:`select`) and centre the view
@@ -82,29 +83,23 @@ class Navigation:
             self.scene.zoom_to(reach)
             self.plotter.render()
 
-    def go_to(self, text: str) -> np.ndarray:
-        """Select and centre on the residues named by ``text`` (``A:45``, ``45`` in the edited
-        chain, ``A:40-50``, ``A:40-42, B:45``, or as ChimeraX and PyMOL name them, a binding site
-        too, measured as the atoms are now: :mod:`core.protein.lookup`), or centre on the
-        ligand, ion, water or nucleotide it names (``A:HEM``, ``/B:20``), selecting nothing;
-        zoom in (never out) until their atoms fill most of the view. Returns the residue-table
-        rows selected (raises ValueError)."""
+    def go_to(self, text: str) -> Selected:
+        """Select and centre on the residues and groups named by ``text`` (``A:45``, ``45`` in
+        the edited chain, ``A:40-50``, ``A:40-42, B:45``, a ligand, ion, water or nucleotide,
+        ``A:HEM``, ``/B:20``, or as ChimeraX and PyMOL name them, a binding site too, measured
+        as the atoms are now: :mod:`core.protein.lookup`); zoom in (never out) until their
+        atoms fill most of the view. Returns what was selected (raises ValueError)."""
         if self.document.model is None:
             raise ValueError("no structure is open")
         structure, coords = self.document.structure, self.document.model.coords
         chain = structure.segments[self.document.segment].chain if structure.segments else None
-        try:
-            rows = find_residues(structure, text, chain, coords)
-        except ValueError:
-            group = find_group(structure, text, chain)
-            if group is None:
-                raise
-            self.document.select([])
-            self._frame(coords[group].mean(axis=0), coords[group])
-            return np.empty(0, dtype=np.int64)
-        self.select(rows)
-        self._frame(coords[self.document.ca_rows[rows]].mean(axis=0), coords[np.isin(structure.atom_residue, rows)])
-        return rows
+        selected = find_selection(structure, text, chain, coords)
+        self.select(selected.residues, selected.groups)
+        atoms = np.union1d(np.flatnonzero(np.isin(structure.atom_residue, selected.residues)), selected.groups)
+        centre = (coords[self.document.ca_rows[selected.residues]] if len(selected.residues)
+                  else coords[selected.groups]).mean(axis=0)
+        self._frame(centre, coords[atoms])
+        return selected
 
     def _frame(self, centre: np.ndarray, atoms: np.ndarray) -> None:
         """Centre the view on ``centre`` (Å) and zoom in until ``atoms`` and a margin fill

@@ -14,6 +14,7 @@ from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
+import numpy as np
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QCursor
 from PySide6.QtWidgets import QApplication, QToolTip
@@ -33,10 +34,11 @@ if TYPE_CHECKING:
 class Gestures:
     """Routes ``plotter``'s pointer events to ``controller`` and the camera; a click goes to
     ``measure`` (what is under it; True when a measuring tool took it) or selects (``select``,
-    residue-table rows), and the hover is named (``name``, '' for nothing)."""
+    residue-table rows, and the coordinate rows of a group: a ligand, ion, water or nucleotide),
+    and the hover is named (``name``, '' for nothing)."""
 
     def __init__(self, document: Document, plotter: View, scene: Scene, controller: DragController, *,
-                 select: Callable[[Sequence[int]], None], name: Callable[[str], None],
+                 select: Callable[[Sequence[int], Sequence[int]], None], name: Callable[[str], None],
                  measure: Callable[[Hit | None], bool] = lambda hit: False) -> None:
         self.document = document
         self.plotter = plotter
@@ -117,18 +119,26 @@ class Gestures:
         """A click that no drag took: an atom for the measuring tool in use, else select the
         residue under the pointer."""
         hit = self._hit(event)
-        if self.measure(hit):
+        if not self.measure(hit):
+            self._select(hit)
+
+    def _select(self, hit: Hit | None) -> None:
+        """Select the residue of ``hit``, or the group of an atom outside the backbone segments."""
+        if hit is None or hit.kind == "point":
             return
-        if hit is not None and hit.row >= 0 and hit.kind != "point":
-            self.select([hit.row])
+        if hit.row >= 0:
+            self.select([hit.row], [])
+        elif hit.kind == "atom":
+            structure = self.document.structure
+            self.select([], np.flatnonzero((structure.atoms.residue == structure.atoms.residue[hit.index])
+                                           & (structure.atom_residue < 0)))
 
     def _centre_on_pointer(self, event: PointerEvent) -> None:
-        """Double click: turn the view about what is under the pointer (and select its residue)."""
+        """Double click: turn the view about what is under the pointer (and select its residue or group)."""
         hit = self._hit(event)
         if hit is None:
             return
-        if hit.row >= 0 and hit.kind != "point":
-            self.select([hit.row])
+        self._select(hit)
         self.scene.centre_on(hit.position)
         self.plotter.render()
 

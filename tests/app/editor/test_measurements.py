@@ -137,26 +137,28 @@ def test_a_residue_clicked_with_the_label_tool_is_labelled(open_window: Opener) 
 
 
 def test_the_residues_of_a_binding_site_are_labelled_at_once(open_window: Opener, qtbot: QtBot) -> None:
-    """Go to Residue selects the haem pocket of chain A; *Label Selected Residues* labels each
-    of its residues at its Cα, in one change, and again only those not labelled yet."""
+    """Go to Residue selects the haem pocket of chain A; *Label Selection* labels each of its
+    residues at its Cα and its waters, in one change, and again only those not labelled yet."""
     window = open_window("4HHB.pdb.gz")
     action = window.measuring.label_selection_action
     action.trigger()  # nothing selected: it says how to select
-    assert "Select residues first" in window.statusBar().currentMessage() and window.rw.measurements == []
+    assert "Select residues or a ligand first" in window.statusBar().currentMessage() and window.rw.measurements == []
     pocket = window.rw.go_to("byres resn HEM and chain A around 4")
     changes: list[int] = []
     window.document.measurements.changed.connect(lambda: changes.append(1))
     action.trigger()
     assert window.rw.measurements == pocket and sorted(_texts(window)) == sorted(pocket) and changes == [1]
-    assert window.measurements_panel.table.rowCount() == len(pocket) == 16
+    assert window.measurements_panel.table.rowCount() == len(pocket) == 20
+    assert pocket[-4:] == ["A:HOH144", "A:HOH159", "A:HOH166", "A:HOH174"]  # in the pocket too, as PyMOL's byres
     window.rw.go_to("A:85-89")  # two of them are in the pocket already
     action.trigger()
     added = window.rw.measurements[len(pocket):]
     assert added == [label for label in window.rw.selection if label not in pocket] and len(added) == 3
-    window.rw.go_to("all")  # 573 residues: more labels than the view can show
+    everything = window.rw.go_to("all")  # every residue, haem and water: more labels than the view can show
     action.trigger()
-    assert window.statusBar().currentMessage() == ("554 labels would hide the molecule: select fewer residues "
-                                                   "(at most 500 at once)")
+    assert window.statusBar().currentMessage() == (f"{len(everything) - len(pocket) - 3} labels would hide the "
+                                                   "molecule: select fewer residues (at most 500 at once)")
+    assert len(everything) > 700
     assert len(window.rw.measurements) == len(pocket) + 3
 
 
@@ -175,9 +177,43 @@ def test_the_polar_contacts_of_a_residue_are_measured_at_once(open_window: Opene
     assert all(" – " in item and "A:ASP189" in item for item in measured)  # each from Asp189 to another
     assert "2.92 Å" in _texts(window) and "2.87 Å" in _texts(window)
     assert window.statusBar().currentMessage() == (f"{len(measured)} polar contacts (N and O 3.5 Å apart or nearer) "
-                                                   "of 1 residue")
+                                                   "of A:ASP189")
+    assert rw.selection == ["A:VAL17", "A:ASP189", "A:SER190", "A:ALA221A", "A:GLY226", "A:BEN1"]  # what it reaches
     action.trigger()
-    assert rw.measurements == measured
+    assert rw.measurements[:len(measured)] == measured
+
+
+def test_a_ligand_is_selected_and_its_hydrogen_bonds_measured(open_window: Opener) -> None:
+    """3PTB: benzamidine selected by name (``resn BEN``) or by a click on one of its atoms;
+    *Show Polar Contacts* measures its hydrogen bonds to trypsin (the salt bridge to Asp189
+    among them), and the residues at their other ends join the selection, their atoms drawn."""
+    window = open_window("3PTB.pdb.gz")
+    rw, document = window.rw, window.document
+    atoms = document.structure.atoms
+    benzamidine = np.flatnonzero(atoms.resname == "BEN")
+    window.scene.centre_on(document.model.coords[benzamidine].mean(axis=0))
+    window.plotter.camera.zoom(4.0)
+    window.plotter.render()
+    towards = -np.array(window.plotter.camera.GetDirectionOfProjection())
+    front = benzamidine[np.argmax(document.model.coords[benzamidine] @ towards)]
+    _click(window, document.model.coords[front])
+    assert rw.selection == ["A:BEN1"] and np.array_equal(document.selected_groups, benzamidine)
+    document.select([])
+    assert rw.go_to("resn BEN") == ["A:BEN1"]
+    window.measuring.label_selection_action.trigger()
+    assert rw.measurements == ["A:BEN1"]
+    window.measuring.contacts_action.trigger()
+    measured = rw.measurements[1:]
+    assert {"A:ASP189 OD1 – A:BEN1 N1: 2.92 Å", "A:ASP189 OD2 – A:BEN1 N2: 2.87 Å"} <= set(measured)
+    assert all(item.endswith(" Å") and "A:BEN1 N" in item for item in measured)
+    partners = {item.split(" ")[0] for item in measured}
+    assert set(rw.selection) == partners | {"A:BEN1"} and {"A:ASP189", "A:GLY219"} <= partners
+    assert window.statusBar().currentMessage() == (f"{len(measured)} polar contacts (N and O 3.5 Å apart or nearer) "
+                                                   "of A:BEN1")
+    drawn = np.asarray(window.scene.meshes["selection_atoms"].points)
+    asp189 = document.model.coords[np.isin(document.structure.atom_residue, document.selection[:1])]
+    for atom in np.concatenate([asp189, document.model.coords[benzamidine]]):  # both ends' atoms drawn
+        assert np.linalg.norm(drawn - atom, axis=1).min() < 1e-3
 
 
 def test_a_label_the_clip_slab_leaves_out_is_not_drawn(open_window: Opener, qtbot: QtBot) -> None:

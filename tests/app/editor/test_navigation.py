@@ -121,7 +121,7 @@ def test_go_to_residue_by_keyboard(window: MainWindow, qtbot: QtBot) -> None:
     qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
     assert list(window.document.selection) == [44]
     np.testing.assert_allclose(_focal(window), _ca(window, 44), atol=1e-6)
-    assert window.status.labels["pick"].text().startswith("selected A:PHE45 (1 residues)")
+    assert window.status.labels["pick"].text() == "selected A:PHE45; Esc clears"
     qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
     qtbot.keyClicks(window.navigation.go_to_field, "30-35")  # the field's text was selected: typing replaces it
     qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
@@ -157,7 +157,7 @@ def test_go_to_residue_by_keyboard(window: MainWindow, qtbot: QtBot) -> None:
 
 def test_go_to_another_chain_makes_it_the_edited_segment(open_window: Opener) -> None:
     window = open_window("4HHB.pdb.gz")
-    rows = window.navigation.go_to("C:87")
+    rows = window.navigation.go_to("C:87").residues
     document = window.document
     assert document.structure.segments[document.segment].chain == "C"
     assert document.structure.residue_label(int(rows[0])) == "C:HIS87"
@@ -209,7 +209,7 @@ def test_go_to_zooms_in_on_what_it_names_and_never_out(open_window: Opener) -> N
     window = open_window("4HHB.pdb.gz")
     camera, document = window.plotter.camera, window.document
     far = camera.distance
-    rows = window.navigation.go_to("byres resn HEM and chain A around 4")
+    rows = window.navigation.go_to("byres resn HEM and chain A around 4").residues
     pocket = document.model.coords[np.isin(document.structure.atom_residue, rows)]
     assert camera.distance < 0.6 * far
     width, height = window.plotter.width(), window.plotter.height()
@@ -221,18 +221,34 @@ def test_go_to_zooms_in_on_what_it_names_and_never_out(open_window: Opener) -> N
     assert camera.distance == pytest.approx(near)
 
 
-def test_go_to_a_ligand_or_a_nucleotide_centres_on_it(open_window: Opener, qtbot: QtBot) -> None:
+def test_go_to_a_ligand_or_a_nucleotide_selects_it(open_window: Opener, qtbot: QtBot) -> None:
+    """A ligand named (``/B:HEM``, ``resn HEM`` in the edited chain) is selected and centred on;
+    every group of a name in a chain (``/A:HOH``), and the groups a combined selection holds, are
+    selected too; Esc clears them with the residues."""
     window = open_window("4HHB.pdb.gz")
-    atoms, coords = window.document.structure.atoms, window.document.model.coords
+    atoms, coords, document = window.document.structure.atoms, window.document.model.coords, window.document
     window.navigation.go_to("A:45")
-    assert window.navigation.go_to("/B:HEM").size == 0 and len(window.document.selection) == 0
+    selected = window.navigation.go_to("/B:HEM")
     haem = (atoms.resname == "HEM") & (atoms.chain == "B")
+    assert selected.residues.size == 0 and len(document.selection) == 0
+    assert np.array_equal(document.selected_groups, np.flatnonzero(haem)) and window.rw.selection == ["B:HEM148"]
+    assert window.status.labels["pick"].text() == "selected B:HEM148; Esc clears"
     np.testing.assert_allclose(_focal(window), coords[haem].mean(axis=0), atol=1e-6)
     window.navigation.go_to("resn HEM")  # the edited chain's (A's, since A:45)
     np.testing.assert_allclose(_focal(window), coords[(atoms.resname == "HEM") & (atoms.chain == "A")].mean(axis=0),
                                atol=1e-6)
-    with pytest.raises(ValueError, match="names 56 groups"):
-        window.navigation.go_to("/A:HOH")
+    assert window.rw.go_to("/A:HOH") == [f"A:HOH{n}" for n in atoms.resseq[(atoms.chain == "A")
+                                                                         & (atoms.resname == "HOH")]]
+    assert window.status.labels["pick"].text() == "selected 56 groups: A:HOH143 … A:HOH198; Esc clears"
+    pocket = window.rw.go_to("resn HEM and chain A or byres resn HEM and chain A around 4")
+    assert pocket[:2] == ["A:TYR42", "A:PHE43"] and pocket[-5:] == ["A:HEM142", "A:HOH144", "A:HOH159", "A:HOH166",
+                                                                      "A:HOH174"]
+    assert window.status.labels["pick"].text() == ("selected 16 residues: A:TYR42, A:PHE43, A:HIS45, A:PHE46 … "
+                                                   "A:LEU136 and 5 groups: A:HEM142 … A:HOH174; Esc clears")
+    window.activateWindow()
+    qtbot.waitUntil(window.isActiveWindow)
+    qtbot.keyClick(window.plotter, Qt.Key.Key_Escape)
+    assert len(document.selection) == 0 and len(document.selected_groups) == 0 and window.rw.selection == []
 
     window = open_window("1BNA.pdb.gz")  # DNA only: no residue of a backbone to select, its nucleotides to go to
     window.activateWindow()

@@ -110,7 +110,9 @@ def test_dna_opens_in_the_window_for_viewing_and_surfaces(qtbot: QtBot, tmp_path
     assert 5.5 < rise < 7.5 and rw.measure("B:DT20") is None
     assert rw.measurements == [f"A:DG4 P – A:DA5 P: {rise:.2f} Å", "B:DT20"]
     assert window.measurements_panel.table.rowCount() == 2
-    assert rw.go_to("B:20") == [] and len(document.selection) == 0
+    assert rw.go_to("B:20") == ["B:DT20"] and len(document.selection) == 0  # the nucleotide, selected
+    assert np.array_equal(document.selected_groups, np.flatnonzero((document.structure.atoms.chain == "B")
+                                                                   & (document.structure.atoms.resseq == 20)))
     for _ in range(2):
         window.measurements_panel.table.selectRow(0)
         window.measurements_panel.delete.click()

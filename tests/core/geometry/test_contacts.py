@@ -6,7 +6,7 @@ import gemmi
 import numpy as np
 import pytest
 
-from core.geometry.contacts import CLOSEST, POLAR_REACH, polar_contacts
+from core.geometry.contacts import CLOSEST, METAL_BOND, POLAR_REACH, polar_contacts
 from core.protein.reading import read_structure
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -33,8 +33,8 @@ def test_benzamidine_in_trypsins_pocket() -> None:
                                                               ("1F9V.pdb.gz", "A", 480, 490)])
 def test_the_contacts_are_those_gemmi_finds(name: str, chain: str, first: int, last: int) -> None:
     """Every N and O pair 2.5-3.5 Å apart, one atom in the residues chosen, the other in another
-    residue (not a water), first conformers, less two backbone N, two backbone O or a proline's
-    N: as gemmi's ContactSearch lists them."""
+    residue (not a water), first conformers, less two backbone N, two backbone O, a proline's
+    N or an N bound to a metal (4HHB's His92 and haem): as gemmi's ContactSearch lists them."""
     structure = read_structure(DATA / name)
     atoms = structure.atoms
     chosen = np.flatnonzero((atoms.chain == chain) & (atoms.resseq >= first) & (atoms.resseq <= last)
@@ -60,10 +60,29 @@ def test_the_contacts_are_those_gemmi_finds(name: str, chain: str, first: int, l
         if ("" not in backbone and (backbone[0] == "N") == (backbone[1] == "N")) or any(
                 c.atom.name == "N" and c.residue.name == "PRO" for c in partners):
             continue
+        if any(c.atom.element.name == "N" and any(m.to_cra(st[0]).atom.element.is_metal
+                                                  for m in ns.find_atoms(c.atom.pos, "\0", radius=METAL_BOND))
+               for c in partners):
+            continue
         rows = tuple(sorted(row_of[end] for end in ends))
         if np.isin(rows, chosen).any():
             theirs.add(rows)
     assert len(ours) > 5 and ours == theirs
+
+
+def test_the_nitrogens_a_metal_holds_make_no_contact() -> None:
+    """4HHB: of chain A's haem, the propionate's salt bridge to His45 is a polar contact; the
+    pyrrole nitrogens and the proximal His87's NE2, all bound to the iron, make none."""
+    haemoglobin = read_structure(DATA / "4HHB.pdb.gz")
+    atoms, coords = haemoglobin.atoms, haemoglobin.coords
+    haem = np.flatnonzero((atoms.resname == "HEM") & (atoms.chain == "A"))
+    pairs = polar_contacts(atoms, coords, haem)
+    named = {(_label(atoms, a), _label(atoms, b)) for a, b in pairs}
+    assert ("A:HIS45 NE2", "A:HEM142 O2D") in named
+    iron = haem[atoms.name[haem] == "FE"][0]
+    held = np.flatnonzero((np.linalg.norm(coords - coords[iron], axis=1) <= METAL_BOND) & (atoms.element == "N"))
+    assert len(held) == 5 and "A:HIS87 NE2" in {_label(atoms, row) for row in held}  # four pyrroles, one histidine
+    assert not np.isin(pairs, held).any()
 
 
 def test_among_leaves_out_the_pairs_within_the_chosen() -> None:

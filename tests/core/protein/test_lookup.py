@@ -1,11 +1,12 @@
 """Residues named as people type them, on real entries."""
 
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from core.protein.lookup import find_atom, find_group, find_residues
+from core.protein.lookup import find_atom, find_group, find_residues, find_selection
 from core.protein.reading import read_structure
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -277,3 +278,64 @@ def test_the_operators_obey_the_laws_of_sets(haemoglobin, seed: int) -> None:
         assert np.array_equal(find_residues(haemoglobin, f"{x} and {y}"), both)
         assert np.array_equal(find_residues(haemoglobin, f"not ({x} and {y})"),
                               find_residues(haemoglobin, f"not {x} or not {y}"))
+
+
+@pytest.mark.parametrize("text", ["A:45", "/B:40-50", "chain A and ss H", "byres resn HEM around 5",
+                                  "resi 40-45 or resi 90", ":HEM :<4.5 & /C", "not chain A"])
+def test_a_selection_holds_the_residues_find_residues_names(haemoglobin, text: str) -> None:
+    assert np.array_equal(find_selection(haemoglobin, text, "A").residues, find_residues(haemoglobin, text, "A"))
+
+
+@pytest.mark.parametrize(("text", "chain", "labels"), [
+    ("/B:HEM", "A", ["B:HEM148"]), ("resn HEM", "C", ["C:HEM142"]),  # one group: in the edited chain
+    ("A:HEM", None, ["A:HEM142"]), ("resn HEM and chain D", None, ["D:HEM148"]),
+    ("resn HEM", None, ["A:HEM142", "B:HEM148", "C:HEM142", "D:HEM148"]),  # combined, or none named: every one
+    ("resn HEM and chain A or byres resn HEM and chain A around 4", None,
+     None),  # a ligand and its pocket, waters too, as PyMOL's byres
+    ("/A:HOH", None, [f"A:HOH{n}" for n in range(143, 199)]), ("solvent and chain A", None,
+                                                                [f"A:HOH{n}" for n in range(143, 199)]),
+    ("inorganic", None, ["B:PO4147", "D:PO4147"]),
+])
+def test_a_selection_holds_whole_groups(haemoglobin, text: str, chain: str | None, labels: list[str] | None) -> None:
+    """Ligands, ions and waters named are selected whole, each group once in its labels."""
+    selected = find_selection(haemoglobin, text, chain)
+    atoms = haemoglobin.atoms
+    group = atoms.residue[selected.groups]
+    assert np.array_equal(selected.groups, np.flatnonzero(np.isin(atoms.residue, group)
+                                                         & (haemoglobin.atom_residue < 0)))  # whole, sorted
+    named = selected.labels(haemoglobin)[len(selected.residues):]
+    if labels is None:
+        pocket = find_residues(haemoglobin, "byres resn HEM and chain A around 4")
+        assert np.array_equal(selected.residues, pocket) and len(pocket) == 16
+        assert named[0] == "A:HEM142" and len(named) > 1 and all(name.startswith("A:HOH") for name in named[1:])
+    else:
+        assert named == labels and not len(selected.residues)
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("A:999", "no residue A:999 in chain A"), ("resn XYZ", "no residue XYZ"),
+    ("resn XYZ or chain Q", "nothing is in 'resn XYZ or chain Q' (no residue or ligand XYZ; no chain Q)"),
+])
+def test_a_selection_of_nothing_is_said_so(haemoglobin, text: str, message: str) -> None:
+    with pytest.raises(ValueError, match=re.escape(message)):
+        find_selection(haemoglobin, text, "A")
+
+
+@pytest.mark.parametrize("text", ["all", "*", "not resn XYZ"])
+def test_everything_selected_holds_every_residue_and_group(haemoglobin, text: str) -> None:
+    selected = find_selection(haemoglobin, text)
+    assert np.array_equal(selected.residues, np.arange(haemoglobin.n_residues))
+    assert np.array_equal(selected.groups, np.flatnonzero(haemoglobin.atom_residue < 0)) and len(selected.groups) > 200
+
+
+@pytest.mark.parametrize(("text", "chain", "labels"), [
+    ("A:140-145", None, ["A:TYR140", "A:ARG141", "A:HEM142", "A:HOH143", "A:HOH144", "A:HOH145"]),  # past the end
+    ("resi 184-186", "C", ["C:HOH184", "C:HOH185", "C:HOH186"]),  # in the edited chain
+    ("/A:45,HEM", None, ["A:HIS45", "A:HEM142"]), ("A:45, A:HEM142, A:999", None, ["A:HIS45", "A:HEM142"]),
+    ("resn HIS+HEM and chain D", None, [f"D:HIS{n}" for n in (2, 63, 77, 92, 97, 116, 117, 143, 146)] + ["D:HEM148"]),
+    ("(resi 184-186 or resi 45) and chain B", None, ["B:PHE45", "B:HOH184", "B:HOH185", "B:HOH186"]),  # as PyMOL's resi
+    ("chain A and resi 142", None, ["A:HEM142"]),
+])
+def test_numbers_ranges_and_lists_name_groups_as_they_name_residues(haemoglobin, text: str, chain: str | None,
+                                                                     labels: list[str]) -> None:
+    assert find_selection(haemoglobin, text, chain).labels(haemoglobin) == labels
