@@ -148,7 +148,7 @@ def find_selection(structure: Structure, text: str, chain: str | None = None, co
     selected = Selected(np.unique(structure.atom_residue[atoms & (structure.atom_residue >= 0)]),
                         np.flatnonzero(atoms & (structure.atom_residue < 0)))
     if not len(selected.residues) and not len(selected.groups):
-        raise ValueError(f"nothing is in {text.strip()!r}" + _missing(missing))
+        raise ValueError(f"{text.strip()!r} selects nothing here" + _missing(missing))
     return selected
 
 

@@ -314,7 +314,7 @@ def test_a_selection_holds_whole_groups(haemoglobin, text: str, chain: str | Non
 
 @pytest.mark.parametrize(("text", "message"), [
     ("A:999", "no residue A:999 in chain A"), ("resn XYZ", "no residue XYZ"),
-    ("resn XYZ or chain Q", "nothing is in 'resn XYZ or chain Q' (no residue or ligand XYZ; no chain Q)"),
+    ("resn XYZ or chain Q", "'resn XYZ or chain Q' selects nothing here (no residue or ligand XYZ; no chain Q)"),
 ])
 def test_a_selection_of_nothing_is_said_so(haemoglobin, text: str, message: str) -> None:
     with pytest.raises(ValueError, match=re.escape(message)):
