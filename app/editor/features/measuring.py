@@ -5,7 +5,7 @@ enough; Esc or the same entry again stops. *Label Selection* labels the residues
 the selection at once (a binding site found with Go to Residue); *Show Polar Contacts* measures
 the hydrogen-bonding distances from them to the atoms around (:mod:`core.geometry.contacts`):
 of a ligand selected (``resn BEN``), its hydrogen bonds to the protein, whose residues join the
-selection so that their atoms show.
+selection so that their atoms show; of a metal site, the bonds of its ion too.
 They are listed in the *Measurements* dock and drawn in the view
 (:mod:`app.editor.scene.layers.measurements`)."""
 
@@ -20,7 +20,7 @@ from app.editor.features.menus import Menus
 from app.editor.interaction.identify import Hit
 from app.editor.measurements import KINDS, checked
 from app.editor.status_bar import selection_text
-from core.geometry.contacts import POLAR_REACH, polar_contacts
+from core.geometry.contacts import POLAR_REACH, metal_bonds, polar_contacts
 from core.protein.lookup import group_starts
 
 MOST_AT_ONCE = 500
@@ -83,15 +83,18 @@ class Measuring:
         document = self.document
         chosen = np.union1d(np.flatnonzero(np.isin(document.structure.atom_residue, document.selection)),
                             document.selected_groups)
-        pairs = polar_contacts(document.structure.atoms, document.model.coords, chosen, among=False)
+        atoms, coords = document.structure.atoms, document.model.coords
+        polar, metal = polar_contacts(atoms, coords, chosen, among=False), metal_bonds(atoms, coords, chosen)
+        pairs = np.concatenate([polar, metal])
         measured = {m.atoms for m in document.measurements.items}
         described = selection_text(document)
         if self._add([pair for pair in map(tuple, pairs.tolist()) if pair not in measured and pair[::-1] not in measured],
                      "polar contacts"):
             self._reveal(pairs[~np.isin(pairs, chosen)])
             self.window.statusBar().showMessage(
-                f"{len(pairs)} polar contact{'' if len(pairs) == 1 else 's'} (N and O {POLAR_REACH:g} Å apart or "
-                f"nearer) of {described}", 8000)
+                f"{len(polar)} polar contact{'' if len(polar) == 1 else 's'} (N and O {POLAR_REACH:g} Å apart or "
+                f"nearer)" + (f" and {len(metal)} metal bond{'' if len(metal) == 1 else 's'}" if len(metal) else "")
+                + f" of {described}", 8000)
 
     def _reveal(self, partners: np.ndarray) -> None:
         """Add the residues and groups of the atoms ``partners`` to the selection, so that their

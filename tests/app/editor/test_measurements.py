@@ -237,3 +237,19 @@ def test_a_label_the_clip_slab_leaves_out_is_not_drawn(open_window: Opener, qtbo
         qtbot.keyClick(window.plotter, Qt.Key.Key_K, Qt.KeyboardModifier.ControlModifier)
         qtbot.waitUntil(lambda frames=frames: window.plotter.frames > frames)
         assert [bool(text.GetVisibility()) for text in texts] == shown
+
+
+def test_a_metal_sites_bonds_are_measured_with_the_polar_contacts(open_window: Opener) -> None:
+    """1AYE: carboxypeptidase's zinc selected; *Show Polar Contacts* measures its bonds to
+    His69, Glu72 (both oxygens), His196 and a water, as the file's LINK records give them,
+    and they join the selection."""
+    window = open_window("1AYE.pdb.gz")
+    rw = window.rw
+    assert rw.go_to("resn ZN") == ["A:ZN400"]
+    window.measuring.contacts_action.trigger()
+    assert rw.measurements == ["A:HIS69 ND1 – A:ZN400 ZN: 2.11 Å", "A:GLU72 OE1 – A:ZN400 ZN: 2.08 Å",
+                               "A:GLU72 OE2 – A:ZN400 ZN: 2.11 Å", "A:HIS196 ND1 – A:ZN400 ZN: 2.12 Å",
+                               "A:ZN400 ZN – A:HOH401 O: 1.98 Å"]
+    assert window.statusBar().currentMessage() == ("0 polar contacts (N and O 3.5 Å apart or nearer) and 5 metal "
+                                                   "bonds of A:ZN400")
+    assert rw.selection == ["A:HIS69", "A:GLU72", "A:HIS196", "A:ZN400", "A:HOH401"]

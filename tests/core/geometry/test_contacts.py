@@ -6,7 +6,7 @@ import gemmi
 import numpy as np
 import pytest
 
-from core.geometry.contacts import CLOSEST, METAL_BOND, POLAR_REACH, polar_contacts
+from core.geometry.contacts import CLOSEST, METAL_BOND, POLAR_REACH, metal_bonds, polar_contacts
 from core.protein.reading import read_structure
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -83,6 +83,26 @@ def test_the_nitrogens_a_metal_holds_make_no_contact() -> None:
     held = np.flatnonzero((np.linalg.norm(coords - coords[iron], axis=1) <= METAL_BOND) & (atoms.element == "N"))
     assert len(held) == 5 and "A:HIS87 NE2" in {_label(atoms, row) for row in held}  # four pyrroles, one histidine
     assert not np.isin(pairs, held).any()
+
+
+@pytest.mark.parametrize("name", ["1AYE.pdb.gz", "3PTB.pdb.gz", "4HHB.pdb.gz", "1BMA.pdb.gz"])
+def test_the_metal_bonds_are_those_the_file_records(name: str) -> None:
+    """The bonds of carboxypeptidase's zinc, trypsin's and elastase's calcium (one of them
+    3.09 Å long) and haemoglobin's iron to the atoms around them, found from the metals or
+    from the atoms they bind, are the file's own metal links (LINK, read by gemmi)."""
+    structure = read_structure(DATA / name)
+    atoms, coords = structure.atoms, structure.coords
+    st = gemmi.read_structure(str(DATA / name))
+    links = {tuple(sorted(f"{p.chain_name}:{p.res_id.name}{p.res_id.seqid.num} {p.atom_name}"
+                          for p in (c.partner1, c.partner2)))
+             for c in st.connections if c.type == gemmi.ConnectionType.MetalC}
+    element = np.char.upper(atoms.element.astype(str))
+    metal = np.flatnonzero(np.isin(element, ("ZN", "CA", "FE")) & (atoms.category != "protein"))
+    for chosen in (metal, np.flatnonzero(atoms.category == "protein")):
+        pairs = metal_bonds(atoms, coords, chosen)
+        found = {tuple(sorted((_label(atoms, a), _label(atoms, b)))) for a, b in pairs}
+        expected = links if len(chosen) == len(metal) else {pair for pair in links if "HOH" not in " ".join(pair)}
+        assert found == expected and len(expected) >= 2
 
 
 def test_among_leaves_out_the_pairs_within_the_chosen() -> None:
