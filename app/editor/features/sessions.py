@@ -190,10 +190,11 @@ class Sessions:
         return session.View(sorted(layer.name for layer in self.scene.layers), self.scene.colouring.value,
                             self.scene.fat_helices, camera, compared, self.scene.helix_cylinders,
                             [m.record() for m in self.document.measurements.items],
-                            None if self.scene.slab is None else list(self.scene.slab))
+                            None if self.scene.slab is None else list(self.scene.slab),
+                            (self.document.selection, self.document.selected_groups))
 
     def _apply_view(self, view: session.View) -> list[str]:
-        """Show ``view``; returns the measurements and compared structures left out, and why."""
+        """Show ``view``; returns the measurements, selection and compared structures left out, and why."""
         for layer, box in self.display_panel.layer_boxes.items():
             box.setChecked(layer.name in view.layers)
         panel = self.display_panel
@@ -208,6 +209,10 @@ class Sessions:
             except (AttributeError, TypeError, ValueError) as error:  # a session written by hand, or damaged
                 left_out.append(f"a measurement ({error})")
         self.document.measurements.replace(measured)  # drawn and listed once
+        try:
+            self.document.select(*view.selection)
+        except ValueError as error:
+            left_out.append(f"the selection ({error})")
         for item in view.compared:
             try:
                 self.comparison.add(item.path, item.chain, item.source)

@@ -26,6 +26,8 @@ MAX_ITEMS = 100_000
 MAX_INDEX = 2**31 - 1
 MAX_COORDINATE = 1e6
 """Å: the largest camera coordinate taken (structures use PDB's own limit, 1e4 Å)."""
+SELECTION = ("selected_residues", "selected_groups")
+"""The arrays of a ``view`` record that hold the selection (newer than the format: optional)."""
 COLOURINGS = ("secondary structure", "residue type", "chain", "rainbow, N to C", "B-factor")
 """The tube's colourings (:class:`app.editor.scene.molecule.Colouring`)."""
 
@@ -200,6 +202,9 @@ def _view(fields: dict, arrays: dict[str, np.ndarray]) -> None:
                    and all(type(x) in (int, float) and abs(x) <= MAX_COORDINATE for x in v), "three coordinates")
     if len(camera) != 3 or np.allclose(camera[0], camera[1]) or not np.any(camera[2]):
         raise Invalid("'camera' must be a position, a focal point apart from it and a view-up direction")
+    for name in SELECTION:  # (newer than the format: optional)
+        if name in arrays:
+            array(arrays, name, "i", (None,))
     compared = items(fields, "compared", lambda v: type(v) is dict, "compared structures")
     for k, entry in enumerate(compared):
         text(entry, "path")

@@ -3,7 +3,8 @@
 A session holds the structure as read (embedded: it opens when the original file has
 moved), the whole undo history at its position, the level, segment and ribbon kind
 (:func:`~app.editor.persistence.recording.recording`), and a ``view`` record: the display
-layers and colouring, the camera and the compared structures (embedded too). It is the
+layers and colouring, the camera, the labels and measurements, the selection and the compared
+structures (embedded too). It is the
 record format of journals (:mod:`app.editor.persistence.records`), written atomically.
 """
 
@@ -15,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from app.editor.persistence import records
+from app.editor.persistence.schema import SELECTION
 from core.protein.writing import atomic_write
 
 SUFFIX = ".rwsession"
@@ -48,6 +50,8 @@ class View:
     """Each label and measurement: its atoms (coordinate rows) and whether it labels a residue."""
     slab: list[float] | None = None
     """The clipping slab (Å in front of and behind the centre), or None."""
+    selection: tuple[np.ndarray, np.ndarray] = (np.empty(0, np.int64), np.empty(0, np.int64))
+    """The selected residues (residue-table rows) and groups (coordinate rows)."""
 
     def record(self) -> records.Record:
         """The ``view`` record of this view."""
@@ -56,6 +60,7 @@ class View:
                   "camera": self.camera,
                   "compared": [{"path": str(c.path), "chain": c.chain, "visible": c.visible} for c in self.compared]}
         arrays = {f"compared_{k}": np.frombuffer(c.source, dtype=np.uint8) for k, c in enumerate(self.compared)}
+        arrays |= {name: np.asarray(rows, dtype=np.int64) for name, rows in zip(SELECTION, self.selection, strict=True)}
         return records.Record("view", fields, arrays)
 
     @classmethod
@@ -64,9 +69,10 @@ class View:
         fields = record.fields
         compared = [ComparedFile(Path(c["path"]), record.arrays[f"compared_{k}"].tobytes(), c["chain"], c["visible"])
                     for k, c in enumerate(fields["compared"])]
+        selection = tuple(record.arrays.get(name, np.empty(0, np.int64)) for name in SELECTION)
         return cls(fields["layers"], fields["colouring"], fields["fat_helices"], fields["camera"], compared,
                    fields.get("helix_cylinders", False), fields.get("measurements", []),
-                   _slab(fields.get("slab")))  # (these three are newer than the format)
+                   _slab(fields.get("slab")), selection)  # (these four are newer than the format)
 
 
 def _slab(value: object) -> list[float] | None:

@@ -152,6 +152,10 @@ CORPUS = {  # field missing, of another type, an unknown enum value, NaN or wron
     "layers as text": _set("view", "layers", "cartoon"),
     "compared without its bytes": _set("view", "compared", [{"path": "x.pdb", "chain": "A", "visible": True}]),
     "measurement of no atoms": _set("view", "measurements", [{"atoms": [10**9]}]),
+    "a selected residue past the residues": _array("view", "selected_residues", lambda a: np.array([10**6])),
+    "a protein atom selected as a group": _array("view", "selected_groups", lambda a: np.array([0])),
+    "a selection of floats": _array("view", "selected_groups", lambda a: np.array([0.5])),
+    "a selection of negative rows": _array("view", "selected_residues", lambda a: np.array([-3])),
     "edits made on another structure": _other_structure,
 }
 

@@ -72,6 +72,7 @@ def test_the_view_and_compared_structures_come_back(qtbot: QtBot, tmp_path: Path
     panel.colouring.setCurrentIndex(panel.colouring.findData(Colouring.CHAIN))
     panel.fat.setChecked(True)
     panel.cylinders.setChecked(True)
+    selection = window.rw.go_to("resn BEN or byres resn BEN around 4")  # a ligand and its pocket, selected
     window.plotter.camera.azimuth = 40
     camera = np.array([tuple(v) for v in window.plotter.camera_position])
     layers = set(window.scene.layers)
@@ -82,6 +83,7 @@ def test_the_view_and_compared_structures_come_back(qtbot: QtBot, tmp_path: Path
     assert other.scene.layers == layers and other.scene.colouring is Colouring.CHAIN and other.scene.fat_helices
     assert other.scene.helix_cylinders and other.display_panel.cylinders.isChecked()
     assert np.allclose([tuple(v) for v in other.plotter.camera_position], camera)
+    assert other.rw.selection == selection and "A:BEN1" in selection and "A:ASP189" in selection
     assert other.plotter.camera.view_angle == window.plotter.camera.view_angle == 30.0  # the same zoom (#35)
     assert [(item.structure.entry_id, item.visible) for item in other.comparison.items] == [("1BMA", False)]
     before, after = window.comparison.items[0].fit, other.comparison.items[0].fit
