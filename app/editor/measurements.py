@@ -65,6 +65,12 @@ def checked(atoms: object, n_atoms: int, residue: bool = False) -> Measurement:
     return Measurement(atoms, bool(residue))
 
 
+def central_atom(coords: np.ndarray, rows: np.ndarray) -> int:
+    """The row among ``rows`` (a group's atoms) nearest their centre, where its label goes (a haem's iron)."""
+    rows = np.asarray(rows)
+    return int(rows[np.argmin(np.linalg.norm(coords[rows] - coords[rows].mean(axis=0), axis=1))])
+
+
 class Measurements(QObject):
     """The labels and measurements of a document, in the order they were made."""
 

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from app.editor.features.export import export_view
+from app.editor.measurements import central_atom
 from app.editor.persistence.session import SUFFIX as SESSION_SUFFIX
 from core.protein.lookup import Selected, find_atom, find_group, find_residues
 
@@ -141,8 +142,9 @@ class EditorAPI:
                 document.measurements.add([int(document.ca_rows[rows[0]])], len(document.model.coords), True)
                 return None
             group = None if len(rows) else find_group(document.structure, atoms[0], chain)
-            if group is not None:  # a ligand, ion, water or nucleotide: its label, on its first atom
-                document.measurements.add([int(group[0])], len(document.model.coords), True)
+            if group is not None:  # a ligand, ion, water or nucleotide: its label, on its central atom
+                coords = document.model.coords
+                document.measurements.add([central_atom(coords, group)], len(coords), True)
                 return None
         rows = [int(atom) if isinstance(atom, (int, np.integer)) else find_atom(document.structure, atom, chain)
                 for atom in atoms]

@@ -18,7 +18,7 @@ from PySide6.QtWidgets import QMainWindow
 from app.editor.document import Document
 from app.editor.features.menus import Menus
 from app.editor.interaction.identify import Hit
-from app.editor.measurements import KINDS, checked
+from app.editor.measurements import KINDS, central_atom, checked
 from app.editor.status_bar import selection_text
 from core.geometry.contacts import POLAR_REACH, metal_bonds, polar_contacts
 from core.protein.lookup import group_starts
@@ -62,16 +62,16 @@ class Measuring:
         self._say()
 
     def label_selection(self) -> None:
-        """Label each selected residue (at its Cα) and group (at its first atom) that has no
+        """Label each selected residue (at its Cα) and group (at its central atom) that has no
         label yet, all in one change."""
         if not self._selected():
             return
         document = self.document
         labelled = {m.atoms for m in document.measurements.items if m.residue}
-        groups = document.selected_groups
-        firsts = groups[group_starts(document.structure, groups)]
-        rows = [(row,) for row in np.concatenate([document.ca_rows[document.selection], firsts]).tolist()
-                if (row,) not in labelled]
+        groups, coords = document.selected_groups, document.model.coords
+        each = np.split(groups, group_starts(document.structure, groups)[1:]) if len(groups) else []
+        centres = [central_atom(coords, group) for group in each]
+        rows = [(row,) for row in document.ca_rows[document.selection].tolist() + centres if (row,) not in labelled]
         self._add(rows, "labels", residue=True)
 
     def show_polar_contacts(self) -> None:

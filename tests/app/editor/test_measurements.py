@@ -107,8 +107,9 @@ def test_labels_angles_and_dihedrals_from_rw_are_gemmis_and_come_back_with_the_s
     assert 1.9 < iron < 2.4 and rw.measurements[-1] == f"A:HEM142 FE – A:HIS87 NE2: {iron:.2f} Å"
     rw.measure("A:HEM142 FE")  # and labelled
     assert rw.measurements[-1] == "A:HEM142 FE"
-    rw.measure("/B:HEM")  # the whole group labelled
+    rw.measure("/B:HEM")  # the whole group labelled, at its centre: the iron
     assert rw.measurements[-1] == "B:HEM148"
+    assert document.structure.atoms.name[document.measurements.items[-1].atoms[0]] == "FE"
     for _ in range(3):
         window.measurements_panel.table.selectRow(len(rw.measurements) - 1)
         window.measurements_panel.delete.click()
