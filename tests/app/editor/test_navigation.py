@@ -13,8 +13,8 @@ from pytestqt.qtbot import QtBot
 
 from app.editor.interaction.drag import HANDLE_BOX, HANDLE_RADIUS
 from app.editor.main_window import MainWindow
-from app.editor.scene.layers.control_points import MIN_POINT_PIXELS
 from app.editor.scene.curves import SIDES
+from app.editor.scene.layers.control_points import MIN_POINT_PIXELS
 from app.editor.scene.layers.tube import TubeLayer
 from app.editor.scene.scene import Layer, Others
 
@@ -78,7 +78,7 @@ def test_hovering_names_the_residue_the_point_and_the_atom(window: MainWindow, q
     row = _front_residue(window, np.arange(document.structure.n_residues))
     qtbot.mouseMove(window.plotter, _widget_point(window, _ca(window, row)))  # a real Qt move
     segment = document.structure.segments[0]
-    expected = f"{segment.labels[row]} · {'helix sheet other'.split()['HEC'.index(segment.ss[row])]}"
+    expected = f"{segment.labels[row]} · {['helix', 'sheet', 'other']['HEC'.index(segment.ss[row])]}"
     assert window.status.labels["hover"].text() == expected
     qtbot.waitUntil(lambda: QToolTip.text() == expected)
 
