@@ -1,11 +1,13 @@
 """Polar contacts: the nitrogen and oxygen atoms of two residues or groups close enough for a
 hydrogen bond (2.5 to 3.5 Å between donor and acceptor), as PyMOL's *find polar contacts*
-and ChimeraX's ``contacts`` show them around a binding site. By distance, less the pairs the
-backbone rules out: two amide nitrogens (donors only), two carbonyl oxygens (acceptors
-only), a proline's nitrogen (neither), and the nitrogens bound to a metal (neither: a haem's
-four and its histidine's, whose lone pairs the iron holds); so of side chains and ligands,
-whose hydrogens a crystal structure seldom gives, a pair of two acceptors may be listed too.
-The bonds of metal ions to the atoms around them are listed apart (:func:`metal_bonds`)."""
+and ChimeraX's ``contacts`` show them around a binding site. By distance, between atoms that
+can donate and accept a hydrogen bond: the roles of the atoms of the standard amino acids and
+nucleotides are known (:data:`PROTEIN_ROLES`, :data:`BASE_ROLES`: a backbone amide donates,
+a carbonyl or a carboxylate accepts, a base pairs as Watson and Crick drew it, a proline's
+nitrogen and a nitrogen bound to a metal, a haem's four, do neither), so two acceptors or two
+donors make no contact; a ligand's atoms, whose hydrogens a crystal structure seldom gives,
+may do either. The bonds of metal ions to the atoms around them are listed apart
+(:func:`metal_bonds`)."""
 
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ import gemmi
 import numpy as np
 from scipy.spatial import cKDTree
 
-from core.protein.structure import AtomTable
+from core.protein.structure import AtomTable, nucleotide_letter
 
 POLAR_REACH = 3.5
 """Å: the farthest a donor and an acceptor of a hydrogen bond are apart."""
@@ -24,27 +26,69 @@ METAL_BOND = 2.6
 METAL_REACH = 3.1
 """Å: the farthest a metal ion and an N, O or S atom it binds are apart (Zn-N 2.1, Ca-O 2.4 to 3.1)."""
 
+DONOR, ACCEPTOR, EITHER, NEITHER = "d", "a", "da", ""
+"""The roles of an atom in hydrogen bonds (a role is the letters of what it can do)."""
+PROTEIN_ROLES = {
+    "N": DONOR, "O": ACCEPTOR, "OXT": ACCEPTOR,
+    "ASP": {"OD1": ACCEPTOR, "OD2": ACCEPTOR}, "GLU": {"OE1": ACCEPTOR, "OE2": ACCEPTOR},
+    "ASN": {"OD1": ACCEPTOR, "ND2": DONOR}, "GLN": {"OE1": ACCEPTOR, "NE2": DONOR},
+    "HIS": {"ND1": EITHER, "NE2": EITHER}, "LYS": {"NZ": DONOR}, "ARG": {"NE": DONOR, "NH1": DONOR, "NH2": DONOR},
+    "SER": {"OG": EITHER}, "THR": {"OG1": EITHER}, "TYR": {"OH": EITHER}, "TRP": {"NE1": DONOR},
+    "PRO": {"N": NEITHER},
+}
+"""Amino acids: the backbone's roles (by atom name), then each side chain's (by residue name)."""
+BASE_ROLES = {
+    "A": {"N1": ACCEPTOR, "N3": ACCEPTOR, "N6": DONOR, "N7": ACCEPTOR, "N9": NEITHER},
+    "G": {"N1": DONOR, "N2": DONOR, "O6": ACCEPTOR, "N3": ACCEPTOR, "N7": ACCEPTOR, "N9": NEITHER},
+    "C": {"N3": ACCEPTOR, "O2": ACCEPTOR, "N4": DONOR, "N1": NEITHER},
+    "T": {"N3": DONOR, "O2": ACCEPTOR, "O4": ACCEPTOR, "N1": NEITHER},
+    "U": {"N3": DONOR, "O2": ACCEPTOR, "O4": ACCEPTOR, "N1": NEITHER},
+}
+"""Nucleotides: each base's roles, by its one-letter code; the sugar-phosphate's are :data:`SUGAR_ROLES`."""
+SUGAR_ROLES = {"OP1": ACCEPTOR, "OP2": ACCEPTOR, "OP3": ACCEPTOR, "O1P": ACCEPTOR, "O2P": ACCEPTOR,
+               "O3'": ACCEPTOR, "O4'": ACCEPTOR, "O5'": ACCEPTOR, "O2'": EITHER}
+"""A nucleotide's sugar and phosphate (the ester oxygens accept only: the pairs across a
+phosphodiester, O3' to the next OP1, are bonded, not hydrogen-bonded)."""
+
+
+def hydrogen_bond_role(category: str, resname: str, name: str, parents: dict[str, str] | None = None) -> str:
+    """What an N or O atom can do in a hydrogen bond (:data:`DONOR`, :data:`ACCEPTOR`,
+    :data:`EITHER` or :data:`NEITHER`), by its residue's category, name and its own name; an
+    atom the tables do not name (a ligand's, a modified residue's side chain) may do either."""
+    if category == "protein":
+        side = PROTEIN_ROLES.get(resname, {})
+        return side.get(name, PROTEIN_ROLES.get(name, EITHER)) if isinstance(side, dict) else EITHER
+    if category == "nucleic":
+        base = BASE_ROLES.get(nucleotide_letter(resname, parents).upper(), {})
+        return base.get(name, SUGAR_ROLES.get(name, EITHER))
+    return EITHER
+
 
 def polar_contacts(atoms: AtomTable, coords: np.ndarray, chosen: np.ndarray, reach: float = POLAR_REACH,
                    *, among: bool = True) -> np.ndarray:
     """(k, 2) coordinate rows of the polar contacts of the atoms ``chosen`` (rows): pairs of a
-    chosen N or O atom and an N or O atom of another residue or group (not water, no N bound
-    to a metal; with ``among`` False, not chosen either) :data:`CLOSEST` to ``reach`` Å from
-    it, on ``coords``; the first alternate conformer only, each pair once, the lower row
-    first, in increasing order."""
+    chosen N or O atom and an N or O atom of another residue or group (not water; with
+    ``among`` False, not chosen either) :data:`CLOSEST` to ``reach`` Å from it, on ``coords``,
+    one able to donate a hydrogen bond and the other to accept it (:func:`hydrogen_bond_role`);
+    the first alternate conformer only, each pair once, the lower row first, in increasing order."""
     element = np.char.upper(atoms.element.astype(str))
-    proline_n = (atoms.category == "protein") & (atoms.resname == "PRO") & (atoms.name == "N")
-    polar = np.flatnonzero(np.isin(element, ("N", "O")) & (atoms.category != "water") & ~proline_n
+    polar = np.flatnonzero(np.isin(element, ("N", "O")) & (atoms.category != "water")
                            & np.isin(atoms.altloc, ("", "A")))
+    keys = np.char.add(np.char.add(atoms.category[polar].astype(str), "|"),
+                       np.char.add(np.char.add(atoms.resname[polar].astype(str), "|"), atoms.name[polar].astype(str)))
+    kinds, which = np.unique(keys, return_inverse=True)
+    roles = np.array([hydrogen_bond_role(*key.split("|"), atoms.parents) for key in kinds.tolist()] or [""])[which]
     metals = _metals(atoms, element)
     if len(metals) and len(polar):  # the nitrogens a metal holds
         bound = cKDTree(coords[metals]).query(coords[polar], distance_upper_bound=METAL_BOND)[0] <= METAL_BOND
-        polar = polar[~(bound & (element[polar] == "N"))]
+        roles[bound & (element[polar] == "N")] = NEITHER
+    polar, roles = polar[roles != NEITHER], roles[roles != NEITHER]
+    role = dict(zip(polar.tolist(), roles.tolist(), strict=True))
     first, second = _near(atoms, coords, np.intersect1d(polar, chosen), polar, reach)
-    backbone = np.where(atoms.category == "protein", atoms.name, "")
-    kind = np.select([backbone == "N", np.isin(backbone, ("O", "OXT"))], ["donor", "acceptor"], "")
-    keep = ((np.linalg.norm(coords[first] - coords[second], axis=1) >= CLOSEST)
-            & ((kind[first] == "") | (kind[first] != kind[second])))
+    one, other = (np.array([role[row] for row in rows.tolist()], dtype="<U2") for rows in (first, second))
+    matched = ((np.char.find(one, DONOR) >= 0) & (np.char.find(other, ACCEPTOR) >= 0)
+               | (np.char.find(one, ACCEPTOR) >= 0) & (np.char.find(other, DONOR) >= 0))
+    keep = (np.linalg.norm(coords[first] - coords[second], axis=1) >= CLOSEST) & matched
     if not among:
         keep &= ~np.isin(second, chosen)
     return _pairs(first[keep], second[keep])

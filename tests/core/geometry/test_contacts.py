@@ -6,10 +6,24 @@ import gemmi
 import numpy as np
 import pytest
 
-from core.geometry.contacts import CLOSEST, METAL_BOND, POLAR_REACH, metal_bonds, polar_contacts
+from core.geometry.contacts import (
+    CLOSEST,
+    METAL_BOND,
+    POLAR_REACH,
+    hydrogen_bond_role,
+    metal_bonds,
+    polar_contacts,
+)
 from core.protein.reading import read_structure
 
 DATA = Path(__file__).resolve().parents[2] / "data"
+
+
+def _category(name: str) -> str:
+    """gemmi's category of a residue name, as the atom table's."""
+    found = gemmi.find_tabulated_residue(name)
+    return "ligand" if found is None else "protein" if found.is_amino_acid() else "nucleic" if found.is_nucleic_acid() \
+        else "ligand"
 
 
 def _label(atoms, row: int) -> str:
@@ -33,8 +47,8 @@ def test_benzamidine_in_trypsins_pocket() -> None:
                                                               ("1F9V.pdb.gz", "A", 480, 490)])
 def test_the_contacts_are_those_gemmi_finds(name: str, chain: str, first: int, last: int) -> None:
     """Every N and O pair 2.5-3.5 Å apart, one atom in the residues chosen, the other in another
-    residue (not a water), first conformers, less two backbone N, two backbone O, a proline's
-    N or an N bound to a metal (4HHB's His92 and haem): as gemmi's ContactSearch lists them."""
+    residue (not a water), first conformers, a donor and an acceptor by their roles, and no N
+    bound to a metal (4HHB's His92 and haem): as gemmi's ContactSearch lists them."""
     structure = read_structure(DATA / name)
     atoms = structure.atoms
     chosen = np.flatnonzero((atoms.chain == chain) & (atoms.resseq >= first) & (atoms.resseq <= last)
@@ -55,10 +69,8 @@ def test_the_contacts_are_those_gemmi_finds(name: str, chain: str, first: int, l
         partners = (contact.partner1, contact.partner2)
         if contact.dist < CLOSEST or not all(c.atom.element.name in ("N", "O") for c in partners):
             continue
-        backbone = [c.atom.name if c.atom.name in ("N", "O", "OXT") and gemmi.find_tabulated_residue(c.residue.name)
-                    .is_amino_acid() else "" for c in partners]
-        if ("" not in backbone and (backbone[0] == "N") == (backbone[1] == "N")) or any(
-                c.atom.name == "N" and c.residue.name == "PRO" for c in partners):
+        roles = [hydrogen_bond_role(_category(c.residue.name), c.residue.name, c.atom.name) for c in partners]
+        if not ("d" in roles[0] and "a" in roles[1] or "a" in roles[0] and "d" in roles[1]):
             continue
         if any(c.atom.element.name == "N" and any(m.to_cra(st[0]).atom.element.is_metal
                                                   for m in ns.find_atoms(c.atom.pos, "\0", radius=METAL_BOND))
@@ -103,6 +115,21 @@ def test_the_metal_bonds_are_those_the_file_records(name: str) -> None:
         found = {tuple(sorted((_label(atoms, a), _label(atoms, b)))) for a, b in pairs}
         expected = links if len(chosen) == len(metal) else {pair for pair in links if "HOH" not in " ".join(pair)}
         assert found == expected and len(expected) >= 2
+
+
+def test_the_base_pairs_of_a_double_helix() -> None:
+    """1BNA, the Dickerson dodecamer: every Watson-Crick hydrogen bond between its strands
+    (three a G-C pair, two an A-T pair) and nothing of the sugars and phosphates, whose ester
+    oxygens, 2.5 Å from the next phosphate's, are bonded, not hydrogen-bonded."""
+    dna = read_structure(DATA / "1BNA.pdb.gz", require_protein=False)
+    atoms = dna.atoms
+    pairs = polar_contacts(atoms, dna.coords, np.flatnonzero(atoms.chain == "A"), among=False)
+    found = {(int(atoms.resseq[a]), str(atoms.name[a]), int(atoms.resseq[b]), str(atoms.name[b])) for a, b in pairs}
+    watson_crick = {"G": [("N1", "N3"), ("N2", "O2"), ("O6", "N4")], "C": [("N3", "N1"), ("O2", "N2"), ("N4", "O6")],
+                    "A": [("N1", "N3"), ("N6", "O4")], "T": [("N3", "N1"), ("O4", "N6")]}
+    for number, letter in enumerate("CGCGAATTCGCG", start=1):
+        assert {(number, mine, 25 - number, theirs) for mine, theirs in watson_crick[letter]} <= found
+    assert len(found) < 45 and not any("'" in name or "P" in name for pair in found for name in pair[1::2])
 
 
 def test_among_leaves_out_the_pairs_within_the_chosen() -> None:
