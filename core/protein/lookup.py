@@ -126,6 +126,12 @@ def _named(structure: Structure, text: str, parts: list[tuple[str, Named]], chai
     return Selected(residues, groups.astype(np.int64))
 
 
+def groups_of(structure: Structure, rows: np.ndarray) -> np.ndarray:
+    """The coordinate rows of the whole groups outside the backbone segments that hold atoms ``rows``, sorted."""
+    residue = structure.atoms.residue
+    return np.flatnonzero(np.isin(residue, residue[rows]) & (structure.atom_residue < 0))
+
+
 def group_starts(structure: Structure, groups: np.ndarray) -> np.ndarray:
     """Indices into ``groups`` (sorted coordinate rows of whole groups) where each group begins."""
     return np.flatnonzero(np.r_[True, np.diff(structure.atoms.residue[groups]) != 0]) if len(groups) else groups[:0]

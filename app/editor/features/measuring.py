@@ -21,7 +21,7 @@ from app.editor.interaction.identify import Hit
 from app.editor.measurements import KINDS, central_atom, checked
 from app.editor.status_bar import selection_text
 from core.geometry.contacts import POLAR_REACH, metal_bonds, polar_contacts
-from core.protein.lookup import group_starts
+from core.protein.lookup import group_starts, groups_of
 
 MOST_AT_ONCE = 500
 """Most labels or contacts made at once: more would hide the molecule, each a text drawn."""
@@ -100,11 +100,9 @@ class Measuring:
         """Add the residues and groups of the atoms ``partners`` to the selection, so that their
         atoms show at the other end of the contacts (as ChimeraX's ``reveal``)."""
         document = self.document
-        structure = document.structure
-        residue = structure.atom_residue
-        groups = np.isin(structure.atoms.residue, structure.atoms.residue[partners]) & (residue < 0)
-        document.select(np.union1d(document.selection, residue[partners][residue[partners] >= 0]),
-                        np.union1d(document.selected_groups, np.flatnonzero(groups)))
+        residues = document.structure.atom_residue[partners]
+        document.select(np.union1d(document.selection, residues[residues >= 0]),
+                        np.union1d(document.selected_groups, groups_of(document.structure, partners)))
 
     def _selected(self) -> bool:
         """Whether residues or groups are selected; if not, the status bar says how to select them."""

@@ -23,6 +23,7 @@ from app.editor.interaction.drag import CLICK_PIXELS, Mode, PointerEvent
 from app.editor.interaction.identify import Hit, describe, identify
 from app.editor.interaction.picking import PRIORITY, PointerAdapter
 from app.editor.scene.scene import Layer
+from core.protein.lookup import groups_of
 
 if TYPE_CHECKING:
     from app.editor.document import Document
@@ -129,9 +130,7 @@ class Gestures:
         if hit.row >= 0:
             self.select([hit.row], [])
         elif hit.kind == "atom":
-            structure = self.document.structure
-            self.select([], np.flatnonzero((structure.atoms.residue == structure.atoms.residue[hit.index])
-                                           & (structure.atom_residue < 0)))
+            self.select([], groups_of(self.document.structure, np.array([hit.index])))
 
     def _centre_on_pointer(self, event: PointerEvent) -> None:
         """Double click: turn the view about what is under the pointer (and select its residue or group)."""
