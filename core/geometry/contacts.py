@@ -2,7 +2,7 @@
 hydrogen bond (2.5 to 3.5 Å between donor and acceptor), as PyMOL's *find polar contacts*
 and ChimeraX's ``contacts`` show them around a binding site. By distance, between atoms that
 can donate and accept a hydrogen bond: the roles of the atoms of the standard amino acids and
-nucleotides are known (:data:`PROTEIN_ROLES`, :data:`BASE_ROLES`: a backbone amide donates,
+nucleotides are known (:data:`BACKBONE_ROLES`, :data:`BASE_ROLES`, ...: a backbone amide donates,
 a carbonyl or a carboxylate accepts, a base pairs as Watson and Crick drew it, a proline's
 nitrogen and a nitrogen bound to a metal, a haem's four, do neither), so two acceptors or two
 donors make no contact; a ligand's atoms, whose hydrogens a crystal structure seldom gives,
@@ -28,15 +28,16 @@ METAL_REACH = 3.1
 
 DONOR, ACCEPTOR, EITHER, NEITHER = "d", "a", "da", ""
 """The roles of an atom in hydrogen bonds (a role is the letters of what it can do)."""
-PROTEIN_ROLES = {
-    "N": DONOR, "O": ACCEPTOR, "OXT": ACCEPTOR,
+BACKBONE_ROLES = {"N": DONOR, "O": ACCEPTOR, "OXT": ACCEPTOR}
+"""An amino acid's backbone (a proline's N aside: :data:`SIDE_CHAIN_ROLES`)."""
+SIDE_CHAIN_ROLES = {
     "ASP": {"OD1": ACCEPTOR, "OD2": ACCEPTOR}, "GLU": {"OE1": ACCEPTOR, "OE2": ACCEPTOR},
     "ASN": {"OD1": ACCEPTOR, "ND2": DONOR}, "GLN": {"OE1": ACCEPTOR, "NE2": DONOR},
     "HIS": {"ND1": EITHER, "NE2": EITHER}, "LYS": {"NZ": DONOR}, "ARG": {"NE": DONOR, "NH1": DONOR, "NH2": DONOR},
     "SER": {"OG": EITHER}, "THR": {"OG1": EITHER}, "TYR": {"OH": EITHER}, "TRP": {"NE1": DONOR},
     "PRO": {"N": NEITHER},
 }
-"""Amino acids: the backbone's roles (by atom name), then each side chain's (by residue name)."""
+"""Each standard amino acid's side chain, by residue name (and a proline's N, which neither donates nor accepts)."""
 BASE_ROLES = {
     "A": {"N1": ACCEPTOR, "N3": ACCEPTOR, "N6": DONOR, "N7": ACCEPTOR, "N9": NEITHER},
     "G": {"N1": DONOR, "N2": DONOR, "O6": ACCEPTOR, "N3": ACCEPTOR, "N7": ACCEPTOR, "N9": NEITHER},
@@ -54,12 +55,11 @@ phosphodiester, O3' to the next OP1, are bonded, not hydrogen-bonded)."""
 def hydrogen_bond_role(category: str, resname: str, name: str, parents: dict[str, str] | None = None) -> str:
     """What an N or O atom can do in a hydrogen bond (:data:`DONOR`, :data:`ACCEPTOR`,
     :data:`EITHER` or :data:`NEITHER`), by its residue's category, name and its own name; an
-    atom the tables do not name (a ligand's, a modified residue's side chain) may do either."""
+    atom the tables do not name (a ligand's, a modified residue's side chain or base) may do either."""
     if category == "protein":
-        side = PROTEIN_ROLES.get(resname, {})
-        return side.get(name, PROTEIN_ROLES.get(name, EITHER)) if isinstance(side, dict) else EITHER
+        return SIDE_CHAIN_ROLES.get(resname, {}).get(name, BACKBONE_ROLES.get(name, EITHER))
     if category == "nucleic":
-        base = BASE_ROLES.get(nucleotide_letter(resname, parents).upper(), {})
+        base = BASE_ROLES.get(nucleotide_letter(resname, parents), {})  # a modified base's (lower case): either
         return base.get(name, SUGAR_ROLES.get(name, EITHER))
     return EITHER
 

@@ -115,12 +115,12 @@ def _named(structure: Structure, text: str, parts: list[tuple[str, Named]], chai
                 continue
             residues.append(structure.atom_residue[atoms & (structure.atom_residue >= 0)])
             groups.append(np.flatnonzero(atoms & (structure.atom_residue < 0)))
-        elif len(parts) == 1:  # one group (``A:HEM142``), or every one of its name (``/A:HOH``)
-            groups.append(find_group(structure, text, chain, several=True))
-        else:
+        elif len(parts) == 1 and (found := find_group(structure, text, chain, several=True)) is not None:
+            groups.append(found)  # one group (``A:HEM142``, ``B:PO4``), or every one of its name (``/A:HOH``)
+        else:  # or of a chain (a DNA strand, ``/B``)
             groups.append(np.flatnonzero(_group_atoms(structure, named, chain)))
     residues = np.unique(np.concatenate(residues or [np.empty(0, dtype=np.int64)]))
-    groups = np.unique(np.concatenate([found for found in groups if found is not None] or [residues[:0]]))
+    groups = np.unique(np.concatenate(groups or [residues[:0]]))
     if not len(residues) and not len(groups):
         raise ValueError("; ".join(dict.fromkeys(missing)))
     return Selected(residues, groups.astype(np.int64))
@@ -298,8 +298,11 @@ def _rows(structure: Structure, text: str, named: Named, chain: str | None) -> n
     """The rows of one residue, range or chain, ``named`` by ``text``."""
     chains = [s.chain for s in structure.segments]
     if named.chain is not None and named.chain not in chains:
-        known = ", ".join(chain or "none (the file names no chain)" for chain in dict.fromkeys(chains)) or "none"
-        raise ValueError(f"no chain {named.chain} with a protein backbone (chains: {known})")
+        every = dict.fromkeys(structure.atoms.chain.tolist())
+        if named.chain in every:  # a chain of DNA, RNA or ligands only
+            raise ValueError(f"no residue {text.strip()} in chain {named.chain} (it has no protein backbone)")
+        known = ", ".join(chain or "none (the file names no chain)" for chain in every) or "none"
+        raise ValueError(f"no chain {named.chain} (chains: {known})")
     if named.first is None:  # a whole chain, or the residues of a name (in every chain where none is named)
         segments = [s for s in structure.segments if named.chain in (None, s.chain)]
         rows = np.concatenate([s.residue_index for s in segments] or [np.empty(0, dtype=np.int64)])

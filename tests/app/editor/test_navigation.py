@@ -262,7 +262,8 @@ def test_go_to_a_ligand_or_a_nucleotide_selects_it(open_window: Opener, qtbot: Q
     qtbot.keyClick(window, Qt.Key.Key_L, Qt.KeyboardModifier.ControlModifier)
     qtbot.keyClicks(window.navigation.go_to_field, "A:500")
     qtbot.keyClick(window.navigation.go_to_field, Qt.Key.Key_Return)
-    assert window.statusBar().currentMessage() == "no chain A with a protein backbone (chains: none)"
+    assert window.statusBar().currentMessage() == "no residue A:500 in chain A (it has no protein backbone)"
+    assert window.rw.go_to("chain A")[:2] == ["A:DC1", "A:DG2"]  # a strand, selected by its chain
 
 
 def test_double_click_centres_on_what_is_under_the_pointer(window: MainWindow, qtbot: QtBot) -> None:
