@@ -110,9 +110,8 @@ def selection_text(document: Document, named: int = 4) -> str:
         shown = ", ".join(label(int(row)) for row in rows[:named])
         residues = f"{len(rows)} residues: {shown}" + (f" … {label(int(rows[-1]))}" if len(rows) > named else "")
     groups = Selected(rows[:0], document.selected_groups).labels(document.structure)
-    if len(groups) > 2:
-        groups = [f"{len(groups)} groups: {groups[0]} … {groups[-1]}"]
-    return " and ".join([residues] + groups if residues else groups)
+    groups = f"{len(groups)} groups: {groups[0]} … {groups[-1]}" if len(groups) > 2 else ", ".join(groups)
+    return " and ".join(part for part in (residues, groups) if part)
 
 
 def _listed(notes: tuple[str, ...], most: int) -> str:
