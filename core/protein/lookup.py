@@ -91,7 +91,7 @@ class Selected:
 
     def labels(self, structure: Structure) -> list[str]:
         """``['A:ASP189', ..., 'A:BEN1']``: the residues, then each group once."""
-        return ([structure.residue_label(int(row)) for row in self.residues]
+        return (structure.residue_labels(self.residues)
                 + [_group_label(structure, int(row)) for row in self.groups[group_starts(structure, self.groups)]])
 
 

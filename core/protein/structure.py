@@ -280,8 +280,13 @@ class Structure:
 
     def residue_label(self, row: int) -> str:
         """The label of residue-table row ``row``, e.g. ``'A:LYS48'``."""
-        segment, index = self.residue_place(row)
-        return self.segments[int(segment)].labels[int(index)]
+        return self.residue_labels([row])[0]
+
+    def residue_labels(self, rows: ArrayLike) -> list[str]:
+        """The labels of residue-table rows ``rows``, e.g. ``['A:LYS48', 'A:GLU49']``."""
+        segments, indices = self.residue_place(np.asarray(rows, dtype=np.int64))
+        return [self.segments[segment].labels[index] for segment, index in zip(segments.tolist(), indices.tolist(),
+                                                                               strict=True)]
 
     def residue_place(self, rows: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """The segment holding each residue-table row of ``rows`` and the row's index within it
