@@ -221,6 +221,7 @@ class MainWindow(QMainWindow):
         self.ramachandran_panel.residueActivated.connect(lambda row: navigation.select_and_centre([row]))
         self.validation_panel.flagActivated.connect(navigation.show_flag)
         self.sequence_bar.strip.residuesActivated.connect(navigation.select_and_centre)
+        self.sequence_bar.strip.groupsActivated.connect(navigation.select_group_and_centre)
         self.correlation.judged.connect(lambda: self.sequence_bar.strip.set_scores(
             None if self.correlation.quality is None else self.correlation.quality.residues))
 

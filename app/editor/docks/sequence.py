@@ -8,8 +8,9 @@ or more; grey where it has none). A click (or a drag across cells) asks for
 those residues to be selected and centred (:attr:`SequenceBar.residuesActivated`, which the
 window connects); Shift extends the selection. Hovering names the residue. After them come
 the letters of the entry's DNA and RNA strands (a modified base in lower case, N where it
-has no known parent), each on its base's colour and headed by its chain (drawn, not edited:
-nothing to select).
+has no known parent), each on its base's colour and headed by its chain (drawn, not edited);
+a click on one selects that nucleotide and centres on it (:attr:`SequenceStrip.groupsActivated`),
+framed as selected residues are.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from app.editor.scene.layers.control_points import PICKED_COLOUR
 from app.editor.scene.layers.selection import SELECTION_COLOUR
 from app.editor.scene.molecule import SS_COLOURS, SS_NAMES
 from app.editor.scene.nucleic import nucleotides
+from core.protein.lookup import Selected, groups_of
 from core.protein.structure import nucleotide_letter
 
 NUMBER_EVERY = 10
@@ -36,6 +38,8 @@ class SequenceStrip(QWidget):
 
     residuesActivated = Signal(object)
     """Residue-table rows (an array) to select and centre on."""
+    groupsActivated = Signal(object)
+    """The coordinate rows of a nucleotide (an array) to select and centre on."""
 
     def __init__(self, document: Document, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -51,6 +55,9 @@ class SequenceStrip(QWidget):
         self._anchor: int | None = None
         self._strands: list[tuple[str, str, np.ndarray]] = []
         """Each nucleic-acid strand's chain, letters and colours."""
+        self._anchors: dict[int, int] = {}
+        """The strands' cells, counted from the segment's last: each one's nucleotide, by an atom
+        row of it (its P or C4')."""
         self.scores: np.ndarray | None = None
         """Each residue's correlation with the map (NaN where none), or None without a map."""
         for signal in (document.segmentChanged, document.picked, document.selectionChanged):
@@ -90,6 +97,12 @@ class SequenceStrip(QWidget):
             (str(found.chain[a]), "".join(nucleotide_letter(str(atoms.resname[row]), atoms.parents)
                                           for row in found.backbone[a:b]), found.colours[a:b])
             for a, b in zip(found.strand_start[:-1], found.strand_start[1:])]
+        self._anchors, k = {}, 0
+        if found is not None:
+            for a, b in zip(found.strand_start[:-1].tolist(), found.strand_start[1:].tolist()):
+                k += STRAND_GAP
+                self._anchors |= {k + n: int(row) for n, row in enumerate(found.backbone[a:b].tolist())}
+                k += b - a
         self._refresh()
 
     def _refresh(self) -> None:
@@ -131,9 +144,19 @@ class SequenceStrip(QWidget):
                 painter.drawText(QPoint(cell.left(), self.row_height - 2), f"{number}{segment.icode[k]}")
         painter.end()
 
+    def nucleotide_at(self, x: int) -> np.ndarray | None:
+        """The coordinate rows of the nucleotide whose letter is at ``x`` pixels, or None."""
+        anchor = self._anchors.get((x - 4) // self.cell - self._count()) if x >= 4 else None
+        return None if anchor is None else groups_of(self.document.structure, np.array([anchor]))
+
     def mousePressEvent(self, event: QMouseEvent) -> None:
+        if event.button() != Qt.MouseButton.LeftButton:
+            return
         residue = self.residue_at(int(event.position().x()))
-        if residue is None or event.button() != Qt.MouseButton.LeftButton:
+        if residue is None:
+            nucleotide = self.nucleotide_at(int(event.position().x()))
+            if nucleotide is not None:
+                self.groupsActivated.emit(nucleotide)
             return
         shift = bool(event.modifiers() & Qt.KeyboardModifier.ShiftModifier)
         if not shift or self._anchor is None:
@@ -143,6 +166,10 @@ class SequenceStrip(QWidget):
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
         residue = self.residue_at(int(event.position().x()))
         if residue is None:
+            nucleotide = self.nucleotide_at(int(event.position().x()))
+            if nucleotide is not None:
+                label = Selected(nucleotide[:0], nucleotide).labels(self.document.structure)[0]
+                QToolTip.showText(event.globalPosition().toPoint(), f"{label} · nucleic acid", self)
             return
         if event.buttons() & Qt.MouseButton.LeftButton and self._anchor is not None:
             self._activate(self._anchor, residue)
@@ -166,6 +193,7 @@ class SequenceStrip(QWidget):
         painter = QPainter(self)
         text = self.palette().windowText().color()
         k = self._count()
+        selected = set(self.document.selected_groups.tolist())
         for chain, letters, colours in self._strands:
             k += STRAND_GAP
             painter.setPen(text)
@@ -173,6 +201,10 @@ class SequenceStrip(QWidget):
             for letter, colour in zip(letters, colours):
                 cell = self.cell_rect(k)
                 painter.fillRect(cell, QColor(*_light(tuple(int(c) for c in colour))))
+                if self._anchors[k - self._count()] in selected:
+                    painter.setPen(QColor(*SELECTION_COLOUR).darker(120))
+                    painter.drawRect(cell.adjusted(0, 0, -1, -1))
+                    painter.setPen(text)
                 painter.drawText(cell, Qt.AlignmentFlag.AlignCenter, letter)
                 k += 1
         painter.end()

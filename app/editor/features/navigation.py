@@ -71,6 +71,12 @@ class Navigation:
                              if point is None else point)
         self.plotter.render()
 
+    def select_group_and_centre(self, group: np.ndarray) -> None:
+        """Select a nucleotide, ligand or ion (``group``: its coordinate rows) and centre the view on it."""
+        self.select([], group)
+        self.scene.centre_on(self.document.model.coords[group].mean(axis=0))
+        self.plotter.render()
+
     def show_flag(self, flag: Flag) -> None:
         """Centre the view on ``flag``'s marker, select its residues (their atoms show: see
         :mod:`app.editor.scene.layers.selection`) and zoom in until they fill about a third of

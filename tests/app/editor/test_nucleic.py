@@ -5,6 +5,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+from PySide6.QtCore import Qt
+from pytestqt.qtbot import QtBot
 
 from app.editor.docks.sequence import STRAND_GAP, _light
 from app.editor.interaction.identify import Hit, describe
@@ -101,3 +103,26 @@ def test_hovering_a_nucleotide_says_it_is_not_edited(open_window: Opener) -> Non
     row = int(np.flatnonzero((atoms.category == "nucleic") & (atoms.name == "P"))[0])
     text = describe(window.document, Hit("atom", atoms.coords[row], -1, row))
     assert text.endswith("P (P) · nucleic acid: drawn, not edited (no curve)")
+
+
+def test_a_click_on_a_strands_letter_selects_its_nucleotide(open_window: Opener, qtbot: QtBot) -> None:
+    """1BNA: B:DT20's letter (the eighth of strand B) clicked in the sequence bar selects that
+    nucleotide, framed there, and centres the view on it; beside a protein's segment (1LCD),
+    the strands' letters come after the segment's."""
+    window = open_window("1BNA.pdb.gz")
+    strip, atoms = window.sequence_bar.strip, window.document.structure.atoms
+    cell = strip.cell_rect(2 * STRAND_GAP + 12 + 7)  # strand A's twelve letters, then B's eighth
+    qtbot.mouseClick(strip, Qt.MouseButton.LeftButton, pos=cell.center())
+    nucleotide = np.flatnonzero((atoms.chain == "B") & (atoms.resseq == 20))
+    assert window.rw.selection == ["B:DT20"] and np.array_equal(window.document.selected_groups, nucleotide)
+    np.testing.assert_allclose(window.plotter.camera.focal_point, atoms.coords[nucleotide].mean(axis=0), atol=1e-6)
+    image = strip.grab().toImage()
+    frame = image.pixelColor(cell.left(), cell.top() + cell.height() // 2)
+    assert (frame.red(), frame.green(), frame.blue()) != _light(nucleic.BASE_COLOURS["T"])  # framed
+    qtbot.mouseClick(strip, Qt.MouseButton.LeftButton, pos=strip.cell_rect(STRAND_GAP - 1).center())  # a gap
+    assert window.rw.selection == ["B:DT20"]
+
+    window = open_window("1LCD.cif.gz")  # the lac repressor's headpiece (51 residues) on its operator
+    strip = window.sequence_bar.strip
+    qtbot.mouseClick(strip, Qt.MouseButton.LeftButton, pos=strip.cell_rect(51 + STRAND_GAP).center())
+    assert window.rw.selection == ["B:DA1"]
