@@ -65,15 +65,17 @@ def hydrogen_bond_role(category: str, resname: str, name: str, parents: dict[str
 
 
 def polar_contacts(atoms: AtomTable, coords: np.ndarray, chosen: np.ndarray, reach: float = POLAR_REACH,
-                   *, among: bool = True) -> np.ndarray:
+                   *, apart: np.ndarray | None = None) -> np.ndarray:
     """(k, 2) coordinate rows of the polar contacts of the atoms ``chosen`` (rows): pairs of a
-    chosen N or O atom and an N or O atom of another residue or group (not water; with
-    ``among`` False, not chosen either) :data:`CLOSEST` to ``reach`` Å from it, on ``coords``,
-    one able to donate a hydrogen bond and the other to accept it (:func:`hydrogen_bond_role`);
-    the first alternate conformer only, each pair once, the lower row first, in increasing order."""
+    chosen N or O atom and an N or O atom of another residue or group (a water only if chosen;
+    not both in ``apart``, as a chain's own when its contacts to the rest are asked)
+    :data:`CLOSEST` to ``reach`` Å from it, on ``coords``, one able to donate a hydrogen bond
+    and the other to accept it (:func:`hydrogen_bond_role`); the first alternate conformer
+    only, each pair once, the lower row first, in increasing order."""
     element = np.char.upper(atoms.element.astype(str))
-    polar = np.flatnonzero(np.isin(element, ("N", "O")) & (atoms.category != "water")
-                           & np.isin(atoms.altloc, ("", "A")))
+    water = atoms.category == "water"
+    water[chosen] = False
+    polar = np.flatnonzero(np.isin(element, ("N", "O")) & ~water & np.isin(atoms.altloc, ("", "A")))
     keys = np.char.add(np.char.add(atoms.category[polar].astype(str), "|"),
                        np.char.add(np.char.add(atoms.resname[polar].astype(str), "|"), atoms.name[polar].astype(str)))
     kinds, which = np.unique(keys, return_inverse=True)
@@ -89,8 +91,8 @@ def polar_contacts(atoms: AtomTable, coords: np.ndarray, chosen: np.ndarray, rea
     matched = ((np.char.find(one, DONOR) >= 0) & (np.char.find(other, ACCEPTOR) >= 0)
                | (np.char.find(one, ACCEPTOR) >= 0) & (np.char.find(other, DONOR) >= 0))
     keep = (np.linalg.norm(coords[first] - coords[second], axis=1) >= CLOSEST) & matched
-    if not among:
-        keep &= ~np.isin(second, chosen)
+    if apart is not None:
+        keep &= ~(np.isin(first, apart) & np.isin(second, apart))
     return _pairs(first[keep], second[keep])
 
 

@@ -75,16 +75,19 @@ class Measuring:
         self._add(rows, "labels", residue=True)
 
     def show_polar_contacts(self) -> None:
-        """Measure each polar contact (N or O within 3.5 Å) from the selected residues and
-        groups to the atoms of other residues and groups, waters aside, as the atoms are now;
-        all in one change. The residues and groups contacted join the selection."""
+        """Measure each polar contact (N and O within 3.5 Å) of the selected residues and
+        groups, to the atoms around them and between the selected ligands, waters and residues
+        (not between two selected residues: a selected chain shows its contacts to the rest;
+        waters only when selected), and each bond of a metal ion among or around them, as the
+        atoms are now; all in one change. The residues and groups contacted join the selection."""
         if not self._selected():
             return
         document = self.document
-        chosen = np.union1d(np.flatnonzero(np.isin(document.structure.atom_residue, document.selection)),
-                            document.selected_groups)
+        residues = np.flatnonzero(np.isin(document.structure.atom_residue, document.selection))
+        chosen = np.union1d(residues, document.selected_groups)
         atoms, coords = document.structure.atoms, document.model.coords
-        polar, metal = polar_contacts(atoms, coords, chosen, among=False), metal_bonds(atoms, coords, chosen)
+        polar = polar_contacts(atoms, coords, chosen, apart=residues)  # (two selected residues: a chain's own)
+        metal = metal_bonds(atoms, coords, chosen)
         pairs = np.concatenate([polar, metal])
         measured = {m.atoms for m in document.measurements.items}
         described = selection_text(document)

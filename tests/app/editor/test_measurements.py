@@ -257,3 +257,20 @@ def test_a_metal_sites_bonds_are_measured_with_the_polar_contacts(open_window: O
     assert window.statusBar().currentMessage() == ("0 polar contacts (N and O 3.5 Å apart or nearer) and 5 metal "
                                                    "bonds of A:ZN400")
     assert rw.selection == ["A:HIS69", "A:GLU72", "A:HIS196", "A:ZN400", "A:HOH401"]
+
+
+def test_a_pockets_contacts_join_its_ligand_its_waters_and_its_residues(open_window: Opener) -> None:
+    """3PTB: benzamidine and its pocket selected together (waters included, as PyMOL's byres):
+    the ligand's hydrogen bonds to the selected residues and waters are measured with the
+    pocket's contacts to the rest, but none between two selected residues."""
+    window = open_window("3PTB.pdb.gz")
+    rw, document = window.rw, window.document
+    pocket = rw.go_to("resn BEN or byres resn BEN around 4")
+    assert {"A:BEN1", "A:HOH416", "A:ASP189"} <= set(pocket)
+    residues = set(document.structure.residue_labels(document.selection))
+    window.measuring.contacts_action.trigger()
+    measured = rw.measurements
+    assert {"A:ASP189 OD1 – A:BEN1 N1: 2.92 Å", "A:BEN1 N2 – A:HOH416 O: 3.13 Å"} <= set(measured)
+    ends = [{end.split(" ")[0] for end in item.rsplit(":", 1)[0].split(" – ")} for item in measured]
+    assert not any(pair <= residues and len(pair) == 2 for pair in ends)  # none between two selected residues
+    assert any(len(pair & set(pocket)) == 1 for pair in ends)  # and the pocket's to the rest

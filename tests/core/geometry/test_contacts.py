@@ -123,7 +123,8 @@ def test_the_base_pairs_of_a_double_helix() -> None:
     oxygens, 2.5 Å from the next phosphate's, are bonded, not hydrogen-bonded."""
     dna = read_structure(DATA / "1BNA.pdb.gz", require_protein=False)
     atoms = dna.atoms
-    pairs = polar_contacts(atoms, dna.coords, np.flatnonzero(atoms.chain == "A"), among=False)
+    strand = np.flatnonzero(atoms.chain == "A")
+    pairs = polar_contacts(atoms, dna.coords, strand, apart=strand)
     found = {(int(atoms.resseq[a]), str(atoms.name[a]), int(atoms.resseq[b]), str(atoms.name[b])) for a, b in pairs}
     watson_crick = {"G": [("N1", "N3"), ("N2", "O2"), ("O6", "N4")], "C": [("N3", "N1"), ("O2", "N2"), ("N4", "O6")],
                     "A": [("N1", "N3"), ("N6", "O4")], "T": [("N3", "N1"), ("O4", "N6")]}
@@ -132,11 +133,22 @@ def test_the_base_pairs_of_a_double_helix() -> None:
     assert len(found) < 45 and not any("'" in name or "P" in name for pair in found for name in pair[1::2])
 
 
-def test_among_leaves_out_the_pairs_within_the_chosen() -> None:
+def test_apart_leaves_out_the_pairs_within_it_and_chosen_waters_take_part() -> None:
+    """A helix's contacts with its own left apart are those to the rest; waters make contacts
+    only when chosen (3PTB: a water bridging benzamidine to the protein)."""
     ubiquitin = read_structure(DATA / "1UBQ.pdb.gz")
     atoms = ubiquitin.atoms
     helix = np.flatnonzero((atoms.resseq >= 23) & (atoms.resseq <= 34) & (atoms.category == "protein"))
-    every, outward = (polar_contacts(atoms, ubiquitin.coords, helix, among=among) for among in (True, False))
+    every, outward = (polar_contacts(atoms, ubiquitin.coords, helix, apart=apart) for apart in (None, helix))
     inside = np.isin(every, helix).all(axis=1)
     assert inside.sum() >= 8  # the helix's own i -> i+4 hydrogen bonds
     assert np.array_equal(outward, every[~inside])
+    trypsin = read_structure(DATA / "3PTB.pdb.gz")
+    atoms = trypsin.atoms
+    benzamidine = np.flatnonzero(atoms.resname == "BEN")
+    alone = polar_contacts(atoms, trypsin.coords, benzamidine)
+    assert not (atoms.category[alone] == "water").any()
+    near = np.linalg.norm(trypsin.coords[:, None] - trypsin.coords[benzamidine], axis=2).min(axis=1) < 3.5
+    waters = np.flatnonzero(near & (atoms.category == "water"))
+    bridged = polar_contacts(atoms, trypsin.coords, np.concatenate([benzamidine, waters]))
+    assert len(waters) and (atoms.category[bridged] == "water").any(axis=1).sum() > len(waters)  # to both sides
