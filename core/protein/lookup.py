@@ -356,12 +356,17 @@ def find_group(structure: Structure, text: str, chain: str | None = None, *, sev
                ) -> np.ndarray | None:
     """Coordinate rows of the one group outside the backbone segments (a ligand, ion, water or
     nucleotide) named by ``text``: by its number, name or both, as residues are named
-    (``A:142``, ``A:HEM142``, ``/A:HEM``, ``resn HEM``) or ``A:HEM``, in ``chain`` when the
-    text names none and that chain has it. None where the text names no such group;
+    (``A:142``, ``A:HEM142``, ``/A:HEM``, ``resn HEM``), ``A:HEM``, or its label (``A:SO4290``,
+    ``:ADP999`` where the file names no chain), in ``chain`` when the text names none and that
+    chain has it. None where the text names no such group;
     ValueError where it names several, unless ``several`` (then all of them)."""
     readings = [read(text.strip())]  # B:PO4 reads as residue 4 named PO, and as the group PO4 of chain B
     if match := re.fullmatch(rf"(?P<chain>{CHAIN})\s*:\s*(?P<name>{NAME})", text.strip()):
         readings.append(Named(match["chain"], name=match["name"]))
+    if label := re.fullmatch(rf"(?P<chain>{CHAIN})?:(?P<rest>[A-Za-z0-9]{{2,12}})", text.strip()):
+        rest = label["rest"]  # a group's label, A:SO4290 or :0QH256: its name, of one to three characters, and number
+        readings += [Named(label["chain"] or "", int(rest[k:]), name=rest[:k]) for k in (3, 2, 1)
+                     if re.fullmatch(NAME, rest[:k]) and rest[k:].isdigit()]
     readings = [named for named in readings if named is not None and named.last is None
                 and (named.first is not None or named.name is not None)]
     if not readings:

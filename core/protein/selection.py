@@ -27,8 +27,12 @@ from dataclasses import dataclass, replace
 
 _NUMBERS = r"(?P<first>-?\d+)(?P<icode>[A-Za-z]?)(?:\s*(?:-|–|\.\.)\s*(?P<last>-?\d+)(?P<last_icode>[A-Za-z]?))?"
 CHAIN = r"[A-Za-z0-9]{1,4}"
-_OWN = re.compile(rf"(?:(?P<chain>{CHAIN})\s*[:/]\s*|(?P<letter>[A-Za-z])(?=-?\d))?"
-                  rf"(?P<name>[A-Za-z]{{1,3}})?{_NUMBERS}")
+_OWN = re.compile(rf"(?:(?P<chain>{CHAIN})\s*[:/]\s*|(?P<blank>:)(?=[A-Za-z]{{1,3}}-?\d)|(?P<letter>[A-Za-z])(?=-?\d))?"
+                  rf"(?P<name>[A-Za-z]{{1,3}}|[A-Za-z][A-Za-z0-9]{{1,2}}|\d[A-Za-z][A-Za-z0-9]?|\d\d[A-Za-z])?"
+                  rf"{_NUMBERS}")
+"""ribbonwave's own names: ``A:45``, ``A45``, ``A:LYS45``, ``A:40-50``, ``A:M3L72`` (a name of one
+to three letters, or else of letters and digits, then the number); ``:ADP999``, a label of
+a file that names no chain (ChimeraX's ``:45`` and ``:his`` are read as ChimeraX reads them)."""
 NAME = r"(?=[A-Za-z0-9]*[A-Za-z])[A-Za-z0-9]{1,5}"
 """A residue or ligand name (HIS, PO4, 5CM, A): letters and digits, at least one letter."""
 _CHIMERAX = re.compile(rf"(?:#\d+(?:\.\d+)*)?\s*(?:/(?P<chain>{CHAIN}))?\s*(?::(?:{_NUMBERS}|(?P<name>{NAME})))?")
@@ -99,7 +103,7 @@ def read_parts(text: str) -> list[tuple[str, Named]] | None:
 def read(text: str) -> Named | None:
     """``text`` read in the first syntax that reads it whole, or None."""
     if match := _OWN.fullmatch(text):
-        return Named.of(match, match["chain"] or match["letter"], match["name"])
+        return Named.of(match, match["chain"] or match["letter"] or ("" if match["blank"] else None), match["name"])
     if text.startswith(("/", "#", ":")) and (match := _CHIMERAX.fullmatch(text)) and (
             match["chain"] or match["first"] or match["name"]):
         return Named.of(match, match["chain"], match["name"])

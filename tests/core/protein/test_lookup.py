@@ -8,6 +8,7 @@ import pytest
 
 from core.protein.lookup import find_atom, find_group, find_residues, find_selection
 from core.protein.reading import read_structure
+from core.protein.selection import read
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 
@@ -339,3 +340,25 @@ def test_everything_selected_holds_every_residue_and_group(haemoglobin, text: st
 def test_numbers_ranges_and_lists_name_groups_as_they_name_residues(haemoglobin, text: str, chain: str | None,
                                                                      labels: list[str]) -> None:
     assert find_selection(haemoglobin, text, chain).labels(haemoglobin) == labels
+
+
+@pytest.mark.parametrize("name", ["4HHB.pdb.gz", "1BMA.pdb.gz", "1F9V.pdb.gz", "7Z9T.cif.gz", "1BNA.pdb.gz",
+                                  "1AKE_adk_closed.pdb.gz", "3PTB.pdb.gz"])
+def test_every_label_names_what_it_labels(name: str) -> None:
+    """What the editor lists as selected (``rw.selection``) can be typed back: residues and
+    groups whose names hold digits (1BMA's SO4290 and 0QH256, 7Z9T's BBB:87B401) and those of a
+    file that names no chain (1F9V's :ADP999, 1AKE's :MET1)."""
+    structure = read_structure(DATA / name, require_protein=False)
+    labels = find_selection(structure, "all").labels(structure)
+    assert len(labels) > 20
+    for label in labels:
+        assert find_selection(structure, label).labels(structure) == [label], label
+
+
+@pytest.mark.parametrize(("text", "name", "number", "icode"), [
+    ("A:M3L72", "M3L", 72, ""), ("A:K45", "K", 45, ""), ("A:45A", None, 45, "A"), ("A:HIS45A", "HIS", 45, "A"),
+    ("A:5CM12", "5CM", 12, ""), ("A:0QH256", "0QH", 256, ""),
+])
+def test_names_with_digits_and_insertion_codes(text: str, name: str | None, number: int, icode: str) -> None:
+    named = read(text)
+    assert (named.chain, named.name, named.first, named.icode) == ("A", name, number, icode)
