@@ -110,7 +110,7 @@ def _named(structure: Structure, text: str, parts: list[tuple[str, Named]], chai
             missing.append(str(error))
         if named.last is not None:
             try:
-                atoms = _part_atoms(structure, part, replace(named, chain=named.chain or chain))
+                atoms = _part_atoms(structure, part, named if named.chain is not None else replace(named, chain=chain))
             except ValueError:
                 continue
             residues.append(structure.atom_residue[atoms & (structure.atom_residue >= 0)])
