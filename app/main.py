@@ -55,6 +55,7 @@ COMMANDS: dict[str, Command] = {
     "fit": Command("move a model onto another conformation, coarse to fine over the levels", "app.cli.fit"),
     "morph": Command("a multi-model movie from one conformation to another, the coarse motion first", "app.cli.fit"),
     "validate": Command("geometry report: peptide junctions, Ramachandran outliers, clashes", "app.cli.validate"),
+    "contacts": Command("the hydrogen bonds and metal bonds of a ligand, residues or a chain", "app.cli.contacts"),
 }
 
 

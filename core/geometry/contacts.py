@@ -64,6 +64,17 @@ def hydrogen_bond_role(category: str, resname: str, name: str, parents: dict[str
     return EITHER
 
 
+def selection_contacts(atoms: AtomTable, coords: np.ndarray, residues: np.ndarray, groups: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """The polar contacts and the metal bonds (each (k, 2) coordinate rows) of a selection: the
+    atoms of its residues ``residues`` and of its groups ``groups`` (ligands, ions, waters,
+    nucleotides), to the atoms around them and among them, but none between two of its
+    residues (a chain selected shows its contacts to the rest, a ligand with its pocket its
+    hydrogen bonds to the pocket)."""
+    chosen = np.union1d(residues, groups).astype(np.int64)
+    return polar_contacts(atoms, coords, chosen, apart=residues), metal_bonds(atoms, coords, chosen)
+
+
 def polar_contacts(atoms: AtomTable, coords: np.ndarray, chosen: np.ndarray, reach: float = POLAR_REACH,
                    *, apart: np.ndarray | None = None) -> np.ndarray:
     """(k, 2) coordinate rows of the polar contacts of the atoms ``chosen`` (rows): pairs of a

@@ -20,7 +20,7 @@ from app.editor.features.menus import Menus
 from app.editor.interaction.identify import Hit
 from app.editor.measurements import KINDS, central_atom, checked
 from app.editor.status_bar import selection_text
-from core.geometry.contacts import POLAR_REACH, metal_bonds, polar_contacts
+from core.geometry.contacts import POLAR_REACH, selection_contacts
 from core.protein.lookup import group_starts, groups_of
 
 MOST_AT_ONCE = 500
@@ -85,9 +85,8 @@ class Measuring:
         document = self.document
         residues = np.flatnonzero(np.isin(document.structure.atom_residue, document.selection))
         chosen = np.union1d(residues, document.selected_groups)
-        atoms, coords = document.structure.atoms, document.model.coords
-        polar = polar_contacts(atoms, coords, chosen, apart=residues)  # (two selected residues: a chain's own)
-        metal = metal_bonds(atoms, coords, chosen)
+        polar, metal = selection_contacts(document.structure.atoms, document.model.coords, residues,
+                                          document.selected_groups)
         pairs = np.concatenate([polar, metal])
         measured = {m.atoms for m in document.measurements.items}
         described = selection_text(document)
