@@ -5,16 +5,9 @@ import json
 from pathlib import Path
 
 import gemmi
-
-from app.main import main
+from test_validate_command import run
 
 DATA = Path(__file__).resolve().parents[2] / "data"
-
-
-def run(capsys, *argv: object) -> tuple[int, str, str]:
-    status = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return status, captured.out, captured.err
 
 
 def test_a_ligands_hydrogen_bonds_as_text(capsys):
