@@ -36,8 +36,7 @@ def run_contacts(args: argparse.Namespace) -> int:
         selected = find_selection(structure, args.selection)
     except ValueError as error:
         raise InputError(str(error)) from None
-    residues = np.flatnonzero(np.isin(structure.atom_residue, selected.residues))
-    polar, metal = selection_contacts(structure.atoms, structure.coords, residues, selected.groups)
+    polar, metal = selection_contacts(structure, structure.coords, selected)
     label = topology(structure).atom_label
     listed = {kind: [([label(int(a)), label(int(b))], float(np.linalg.norm(structure.coords[a] - structure.coords[b])))
                      for a, b in pairs] for kind, pairs in (("hydrogen_bonds", polar), ("metal_bonds", metal))}

@@ -32,6 +32,7 @@ from app.editor.scene.curves import LevelCurve, SegmentPath, segment_paths
 from core.geometry.regularize import FLANK, regularize_region, regularized
 from core.protein.assembly import assembly_path, assembly_text
 from core.protein.input_files import read_bytes
+from core.protein.lookup import Selected
 from core.protein.model import Edit, EditableModel
 from core.protein.reading import read_structure
 from core.protein.ribbon import RibbonKind
@@ -147,9 +148,8 @@ class Document(QObject):
     def title(self) -> str:
         """The file's name, with the model for a multi-model entry: ``'1L2Y.pdb.gz (model 3 of 38)'``."""
         name = self.path.name if self.path is not None else "untitled"
-        if self.model is None or self.structure.n_models == 1:
-            return name
-        return f"{name} (model {self.model_number} of {self.structure.n_models})"
+        several = self.model is not None and self.structure.n_models > 1
+        return f"{name} (model {self.model_number} of {self.structure.n_models})" if several else name
 
     @property
     def modified(self) -> bool:
@@ -174,23 +174,21 @@ class Document(QObject):
             self._curves[segment] = self.paths[segment].level_curve(ribbon, self.shown_level(segment))
         return self._curves[segment]
 
-    def deviation(self, segment: int | None = None) -> float:
-        """rms |Cα − C^r| (Å) of ``segment`` at its shown level, with the current Cα positions."""
-        segment = self.segment if segment is None else segment
-        ca = self._model.coords[self.ca_rows[self.structure.segments[segment].residue_index]]
-        offset = self.level_curve(segment).residue_points - ca
+    def deviation(self) -> float:
+        """rms |Cα − C^r| (Å) of the current segment at its shown level, with the current Cα positions."""
+        ca = self._model.coords[self.ca_rows[self.structure.segments[self.segment].residue_index]]
+        offset = self.level_curve().residue_points - ca
         return float(np.sqrt(np.mean(np.einsum("ij,ij->i", offset, offset))))
 
-    def labels(self, segment: int | None = None) -> tuple[str, ...]:
-        """Residue labels of ``segment`` (default: the current one), e.g. ``'A:LYS48'``."""
-        return self.structure.segments[self.segment if segment is None else segment].labels
+    def labels(self) -> tuple[str, ...]:
+        """Residue labels of the current segment, e.g. ``'A:LYS48'``."""
+        return self.structure.segments[self.segment].labels
 
-    def residue_range(self, residues: np.ndarray, segment: int | None = None) -> str:
-        """E.g. ``'A:LYS6–A:THR9'`` (or ``'none'``)."""
+    def residue_range(self, residues: np.ndarray) -> str:
+        """``residues`` of the current segment in a few words: ``'A:LYS6–A:THR9'`` (or ``'none'``)."""
         if len(residues) == 0:
             return "none"
-        labels = self.labels(segment)
-        first, last = labels[int(residues[0])], labels[int(residues[-1])]
+        first, last = (self.labels()[int(residues[k])] for k in (0, -1))
         return first if first == last else f"{first}–{last}"
 
     # ------------------------------------------------------------------ mutators
@@ -276,16 +274,10 @@ class Document(QObject):
 
     def select(self, rows: np.ndarray | list[int], groups: np.ndarray | list[int] = ()) -> None:
         """Select residues by residue-table row and groups outside the backbone segments by
-        coordinate row (none: an empty selection)."""
-        rows = np.unique(np.asarray(rows, dtype=np.int64))
-        groups = np.unique(np.asarray(groups, dtype=np.int64))
-        if len(rows) and not 0 <= rows[0] <= rows[-1] < self.structure.n_residues:
-            raise ValueError(f"residue rows must be in [0, {self.structure.n_residues - 1}]")
-        if len(groups) and not (0 <= groups[0] <= groups[-1] < self.structure.n_atoms
-                                and (self.structure.atom_residue[groups] < 0).all()):
-            raise ValueError("a selected group's rows must be atoms outside the backbone segments")
-        if not np.array_equal(rows, self.selection) or not np.array_equal(groups, self.selected_groups):
-            self.selection, self.selected_groups = rows, groups
+        coordinate row (none: an empty selection; ValueError: :meth:`Selected.of`)."""
+        new = Selected.of(self.structure, rows, groups)
+        if not (np.array_equal(new.residues, self.selection) and np.array_equal(new.groups, self.selected_groups)):
+            self.selection, self.selected_groups = new.residues, new.groups
             self.selectionChanged.emit()
 
     @property

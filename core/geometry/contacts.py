@@ -15,7 +15,8 @@ import gemmi
 import numpy as np
 from scipy.spatial import cKDTree
 
-from core.protein.structure import AtomTable, nucleotide_letter
+from core.protein.lookup import Selected
+from core.protein.structure import AtomTable, Structure, nucleotide_letter
 
 POLAR_REACH = 3.5
 """Å: the farthest a donor and an acceptor of a hydrogen bond are apart."""
@@ -64,15 +65,16 @@ def hydrogen_bond_role(category: str, resname: str, name: str, parents: dict[str
     return EITHER
 
 
-def selection_contacts(atoms: AtomTable, coords: np.ndarray, residues: np.ndarray, groups: np.ndarray
-                       ) -> tuple[np.ndarray, np.ndarray]:
-    """The polar contacts and the metal bonds (each (k, 2) coordinate rows) of a selection: the
-    atoms of its residues ``residues`` and of its groups ``groups`` (ligands, ions, waters,
-    nucleotides), to the atoms around them and among them, but none between two of its
-    residues (a chain selected shows its contacts to the rest, a ligand with its pocket its
-    hydrogen bonds to the pocket)."""
-    chosen = np.union1d(residues, groups).astype(np.int64)
-    return polar_contacts(atoms, coords, chosen, apart=residues), metal_bonds(atoms, coords, chosen)
+def selection_contacts(structure: Structure, coords: np.ndarray, selected: Selected) -> tuple[np.ndarray, np.ndarray]:
+    """The polar contacts and the metal bonds (each (k, 2) coordinate rows, on ``coords``) of
+    the atoms of ``selected``'s residues and groups (ligands, ions, waters, nucleotides), to
+    the atoms around them and among them, but none between two of its residues (a chain
+    selected shows its contacts to the rest, a ligand with its pocket its hydrogen bonds to
+    the pocket)."""
+    residues = np.flatnonzero(np.isin(structure.atom_residue, selected.residues))
+    chosen = np.union1d(residues, selected.groups)
+    return (polar_contacts(structure.atoms, coords, chosen, apart=residues),
+            metal_bonds(structure.atoms, coords, chosen))
 
 
 def polar_contacts(atoms: AtomTable, coords: np.ndarray, chosen: np.ndarray, reach: float = POLAR_REACH,
@@ -87,21 +89,19 @@ def polar_contacts(atoms: AtomTable, coords: np.ndarray, chosen: np.ndarray, rea
     water = atoms.category == "water"
     water[chosen] = False
     polar = np.flatnonzero(np.isin(element, ("N", "O")) & ~water & np.isin(atoms.altloc, ("", "A")))
-    keys = np.char.add(np.char.add(atoms.category[polar].astype(str), "|"),
-                       np.char.add(np.char.add(atoms.resname[polar].astype(str), "|"), atoms.name[polar].astype(str)))
-    kinds, which = np.unique(keys, return_inverse=True)
-    roles = np.array([hydrogen_bond_role(*key.split("|"), atoms.parents) for key in kinds.tolist()] or [""])[which]
+    keys = np.stack([atoms.category[polar], atoms.resname[polar], atoms.name[polar]], axis=1).astype(str)
+    kinds, which = np.unique(keys, axis=0, return_inverse=True)  # each kind of atom's role looked up once
+    role = np.full(len(atoms), NEITHER, dtype="<U2")
+    role[polar] = np.array([hydrogen_bond_role(*kind, atoms.parents) for kind in kinds.tolist()] or [NEITHER])[which]
     metals = _metals(atoms, element)
     if len(metals) and len(polar):  # the nitrogens a metal holds
         bound = cKDTree(coords[metals]).query(coords[polar], distance_upper_bound=METAL_BOND)[0] <= METAL_BOND
-        roles[bound & (element[polar] == "N")] = NEITHER
-    polar, roles = polar[roles != NEITHER], roles[roles != NEITHER]
-    role = dict(zip(polar.tolist(), roles.tolist(), strict=True))
+        role[polar[bound & (element[polar] == "N")]] = NEITHER
+    polar = polar[role[polar] != NEITHER]
+    donates, accepts = (np.char.find(role, letter) >= 0 for letter in (DONOR, ACCEPTOR))
     first, second = _near(atoms, coords, np.intersect1d(polar, chosen), polar, reach)
-    one, other = (np.array([role[row] for row in rows.tolist()], dtype="<U2") for rows in (first, second))
-    matched = ((np.char.find(one, DONOR) >= 0) & (np.char.find(other, ACCEPTOR) >= 0)
-               | (np.char.find(one, ACCEPTOR) >= 0) & (np.char.find(other, DONOR) >= 0))
-    keep = (np.linalg.norm(coords[first] - coords[second], axis=1) >= CLOSEST) & matched
+    keep = ((np.linalg.norm(coords[first] - coords[second], axis=1) >= CLOSEST)
+            & (donates[first] & accepts[second] | accepts[first] & donates[second]))
     if apart is not None:
         keep &= ~(np.isin(first, apart) & np.isin(second, apart))
     return _pairs(first[keep], second[keep])
@@ -119,7 +119,7 @@ def metal_bonds(atoms: AtomTable, coords: np.ndarray, chosen: np.ndarray) -> np.
     binding = np.flatnonzero(np.isin(element, ("N", "O", "S")) & first_conformer)
     found = [_near(atoms, coords, np.intersect1d(metals, chosen), binding, METAL_REACH),
              _near(atoms, coords, np.intersect1d(binding, chosen), metals, METAL_REACH)]
-    return _pairs(np.concatenate([found[0][0], found[1][0]]), np.concatenate([found[0][1], found[1][1]]))
+    return _pairs(*(np.concatenate(ends) for ends in zip(*found, strict=True)))
 
 
 def _metals(atoms: AtomTable, element: np.ndarray) -> np.ndarray:

@@ -89,10 +89,23 @@ class Selected:
     residues: np.ndarray
     groups: np.ndarray
 
+    @classmethod
+    def of(cls, structure: Structure, residues: np.ndarray | list[int], groups: np.ndarray | list[int] = ()
+           ) -> Selected:
+        """The selection of residue-table rows ``residues`` and of the coordinate rows ``groups``
+        (each once, sorted); ValueError for a row the structure lacks, or a group's inside a segment."""
+        residues, groups = (np.unique(np.asarray(rows, dtype=np.int64)) for rows in (residues, groups))
+        if len(residues) and not 0 <= residues[0] <= residues[-1] < structure.n_residues:
+            raise ValueError(f"residue rows must be in [0, {structure.n_residues - 1}]")
+        if len(groups) and not (0 <= groups[0] <= groups[-1] < structure.n_atoms
+                                and (structure.atom_residue[groups] < 0).all()):
+            raise ValueError("a selected group's rows must be atoms outside the backbone segments")
+        return cls(residues, groups)
+
     def labels(self, structure: Structure) -> list[str]:
         """``['A:ASP189', ..., 'A:BEN1']``: the residues, then each group once."""
         return (structure.residue_labels(self.residues)
-                + [_group_label(structure, int(row)) for row in self.groups[group_starts(structure, self.groups)]])
+                + [group_label(structure, int(row)) for row in self.groups[group_starts(structure, self.groups)]])
 
 
 def _named(structure: Structure, text: str, parts: list[tuple[str, Named]], chain: str | None) -> Selected:
@@ -342,7 +355,7 @@ def find_atom(structure: Structure, text: str, chain: str | None = None) -> int:
             raise
         atoms = group[structure.atoms.name[group] == name.upper()]
         if not len(atoms):
-            raise ValueError(f"no atom {name.upper()} in {_group_label(structure, int(group[0]))}") from None
+            raise ValueError(f"no atom {name.upper()} in {group_label(structure, int(group[0]))}") from None
         return int(atoms[0])
     if len(rows) != 1:
         raise ValueError(f"{text.strip()!r} names {len(rows)} residues: name one, and an atom of it")
@@ -382,7 +395,7 @@ def find_group(structure: Structure, text: str, chain: str | None = None, *, sev
         return None
     groups, first = np.unique(structure.atoms.residue[rows], return_index=True)
     if len(groups) > 1 and not several:
-        names = [_group_label(structure, int(row)) for row in rows[np.sort(first)][:6].tolist()]
+        names = [group_label(structure, int(row)) for row in rows[np.sort(first)][:6].tolist()]
         raise ValueError(f"{text.strip()!r} names {len(groups)} groups ({', '.join(names)}"
                          + (", ..." if len(groups) > 6 else "") + "): name one")
     return rows
@@ -403,8 +416,8 @@ def _group_atoms(structure: Structure, named: Named, chain: str | None) -> np.nd
     return chosen
 
 
-def _group_label(structure: Structure, row: int) -> str:
-    """``A:HEM142``: the group of atom ``row``."""
+def group_label(structure: Structure, row: int) -> str:
+    """``A:HEM142``: the group of atom ``row`` (``:ADP999`` where the file names no chain)."""
     atoms = structure.atoms
     return f"{atoms.chain[row]}:{atoms.resname[row]}{atoms.resseq[row]}"
 

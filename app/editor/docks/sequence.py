@@ -25,7 +25,7 @@ from app.editor.scene.layers.control_points import PICKED_COLOUR
 from app.editor.scene.layers.selection import SELECTION_COLOUR
 from app.editor.scene.molecule import SS_COLOURS, SS_NAMES
 from app.editor.scene.nucleic import nucleotides
-from core.protein.lookup import Selected, groups_of
+from core.protein.lookup import group_label, groups_of
 from core.protein.structure import nucleotide_letter
 
 NUMBER_EVERY = 10
@@ -168,7 +168,7 @@ class SequenceStrip(QWidget):
         if residue is None:
             nucleotide = self.nucleotide_at(int(event.position().x()))
             if nucleotide is not None:
-                label = Selected(nucleotide[:0], nucleotide).labels(self.document.structure)[0]
+                label = group_label(self.document.structure, int(nucleotide[0]))
                 QToolTip.showText(event.globalPosition().toPoint(), f"{label} · nucleic acid", self)
             return
         if event.buttons() & Qt.MouseButton.LeftButton and self._anchor is not None:

@@ -21,7 +21,7 @@ from app.editor.interaction.identify import Hit
 from app.editor.measurements import KINDS, central_atom, checked
 from app.editor.status_bar import selection_text
 from core.geometry.contacts import POLAR_REACH, selection_contacts
-from core.protein.lookup import group_starts, groups_of
+from core.protein.lookup import Selected, group_starts, groups_of
 
 MOST_AT_ONCE = 500
 """Most labels or contacts made at once: more would hide the molecule, each a text drawn."""
@@ -83,24 +83,22 @@ class Measuring:
         if not self._selected():
             return
         document = self.document
-        residues = np.flatnonzero(np.isin(document.structure.atom_residue, document.selection))
-        chosen = np.union1d(residues, document.selected_groups)
-        polar, metal = selection_contacts(document.structure.atoms, document.model.coords, residues,
-                                          document.selected_groups)
+        polar, metal = selection_contacts(document.structure, document.model.coords,
+                                          Selected(document.selection, document.selected_groups))
         pairs = np.concatenate([polar, metal])
         measured = {m.atoms for m in document.measurements.items}
         described = selection_text(document)
         if self._add([pair for pair in map(tuple, pairs.tolist()) if pair not in measured and pair[::-1] not in measured],
                      "polar contacts"):
-            self._reveal(pairs[~np.isin(pairs, chosen)])
+            self._reveal(pairs.ravel())
             self.window.statusBar().showMessage(
                 f"{len(polar)} polar contact{'' if len(polar) == 1 else 's'} (N and O {POLAR_REACH:g} Å apart or "
                 f"nearer)" + (f" and {len(metal)} metal bond{'' if len(metal) == 1 else 's'}" if len(metal) else "")
                 + f" of {described}", 8000)
 
     def _reveal(self, partners: np.ndarray) -> None:
-        """Add the residues and groups of the atoms ``partners`` to the selection, so that their
-        atoms show at the other end of the contacts (as ChimeraX's ``reveal``)."""
+        """Add the residues and groups of the atoms ``partners`` (the contacts' ends) to the
+        selection, so that their atoms show (as ChimeraX's ``reveal``)."""
         document = self.document
         residues = document.structure.atom_residue[partners]
         document.select(np.union1d(document.selection, residues[residues >= 0]),
